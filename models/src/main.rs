@@ -1,0 +1,2 @@
+//! The `pfaff` command-line program.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Integration, accuracy and snapshot tests of pfaff.
