@@ -120,6 +120,9 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
                 model.coords.push(Coord { name, docs, q0, qd0 });
             }
             parse::Item::Fn(f) => {
+                if f.name == kw::DELTA {
+                    cx.error_spanned_by(&f.name, "`delta` is reserved for variations and cannot name a function");
+                }
                 declare(&f.name);
                 let slot = match &f.role {
                     Role::KineticEnergy => &mut model.kinetic,

@@ -14,8 +14,9 @@ pub const DOT: &str = "dot";
 pub const DELTA: &str = "delta";
 pub const TIME: &str = "t";
 
-/// Names users may not declare: they mean something already.
-pub const RESERVED: &[&str] = &[TIME, DELTA, "self", "q", "qd", "out"];
+/// Names users may not declare: they mean something already. (`delta` stays free for
+/// coordinates — `delta(..)` is a call, so the two never meet — but not for functions.)
+pub const RESERVED: &[&str] = &[TIME, "self", "q", "qd", "out"];
 
 /// Mathematical constants usable in expressions.
 pub fn constant(name: &str) -> Option<f64> {

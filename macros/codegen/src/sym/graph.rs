@@ -11,6 +11,7 @@
 //!   (`2x + 3x = 5x`, `x − x = 0`, `x · x = x²`, `x / x = 1`);
 //! - `sin²u + cos²u = 1` (with equal coefficients and cofactors);
 //! - integer powers are merged and distributed over products, `(√x)² = x`;
+//! - a constant coefficient is distributed over a sum, `c(a + b) = ca + cb`;
 //! - signs are pulled out of odd functions and dropped inside even ones.
 //!
 //! A raw graph only hash-conses: it keeps exactly what was written. Rebuilding a raw
@@ -370,6 +371,18 @@ impl Graph {
         }
         if coefficient == 0.0 {
             return self.constant(0.0);
+        }
+        // `c · (a + b) = c·a + c·b`: distributing a lone coefficient lets like terms
+        // meet (`½(2a + 2b) − a = b`).
+        if coefficient != 1.0 && powers.len() == 1 {
+            let (&base, &n) = powers.iter().next().expect("one factor");
+            if n == 1 {
+                if let Node::Add(terms) = self.node(base).clone() {
+                    let c = self.constant(coefficient);
+                    let scaled = terms.iter().map(|&t| self.mul(vec![c, t])).collect();
+                    return self.add(scaled);
+                }
+            }
         }
         let mut out = Vec::with_capacity(powers.len() + 1);
         for (base, n) in powers {
