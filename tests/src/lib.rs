@@ -1,1 +1,6 @@
 //! Integration, accuracy and snapshot tests of pfaff.
+//!
+//! One test binary: this library, compiled with `cfg(test)`, holds every module.
+
+#[cfg(test)]
+mod ui;
