@@ -22,12 +22,21 @@ fn hand_derivatives_match_finite_differences() {
     let qd9 = [0.3, -1.0, 2.0, 0.5, 0.4, -3.0, 1.0, 0.2, -0.1];
     assert_derivatives(&SliderCrank::new(true), 0.3, &q9, &qd9);
     assert_derivatives(&SliderCrank::new(false), 0.3, &q9, &qd9);
-    assert_derivatives(&Sleigh::default(), 0.0, &[0.2, -0.1, 0.9], &[1.0, 0.3, -0.5]);
+    assert_derivatives(
+        &Sleigh::default(),
+        0.0,
+        &[0.2, -0.1, 0.9],
+        &[1.0, 0.3, -0.5],
+    );
     assert_derivatives(&Pendulum::new(false), 0.0, &[0.3, -0.8], &[1.0, 0.2]);
     assert_derivatives(&Pendulum::new(true), 0.0, &[0.3, -0.8], &[1.0, 0.2]);
     let chain = Chain::new(6);
     let (q, qd) = chain.state();
-    let q: Vec<f64> = q.iter().enumerate().map(|(i, v)| v + 0.01 * i as f64).collect();
+    let q: Vec<f64> = q
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v + 0.01 * i as f64)
+        .collect();
     assert_derivatives(&chain, 0.0, &q, &qd);
 }
 
@@ -52,4 +61,40 @@ fn energy_residuals_and_dense_matrices() {
     let mut m = [0.0; 9];
     s.mass_matrix_dense_inplace(0.0, &[0.0; 3], &mut m);
     assert_eq!(m, [2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.05]);
+}
+
+#[test]
+fn malformed_patterns_are_rejected() {
+    static BAD: pfaff::Info = pfaff::Info {
+        name: "bad",
+        doc: "",
+        coordinates: &[
+            pfaff::Symbol { name: "x", doc: "" },
+            pfaff::Symbol { name: "y", doc: "" },
+        ],
+        parameters: &[],
+        holonomic: &[pfaff::Symbol { name: "c", doc: "" }],
+        nonholonomic: &[],
+        mass_pattern: &[(1, 1), (0, 0)],
+        holonomic_pattern: &[(0, 0), (0, 2)],
+        nonholonomic_pattern: &[],
+        time: pfaff::TimeDependence {
+            mass: false,
+            forces: false,
+            holonomic: false,
+            nonholonomic: false,
+        },
+        nonholonomic_homogeneous: true,
+        conservative: true,
+    };
+    let err = pfaff::Workspace::new(&BAD).unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        pfaff::EvalError::Pattern {
+            entry: 1,
+            reason: pfaff::PatternDefect::Unsorted,
+            ..
+        }
+    ));
 }

@@ -6,8 +6,8 @@ mod common;
 use common::Pendulum;
 use pfaff::{
     AssemblyError, Dynamics, DynamicsParams, EvalError, Kinematics, KinematicsError,
-    KinematicsParams, LinearSolver, Mechanism, PartitionError, Prescription, Quantity,
-    SolverPath, Workspace,
+    KinematicsParams, LinearSolver, Mechanism, PartitionError, Prescription, Quantity, SolverPath,
+    Workspace,
 };
 
 #[test]
@@ -34,7 +34,10 @@ fn hanging_pendulum_forces_repartition_to_y() {
     // K1 with x fixed near the bottom now works.
     let mut q = [0.01, -0.98];
     let stats = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap();
-    assert!((q[1] + (1.0 - 0.0001_f64).sqrt()).abs() < 1e-14, "{stats:?}");
+    assert!(
+        (q[1] + (1.0 - 0.0001_f64).sqrt()).abs() < 1e-14,
+        "{stats:?}"
+    );
 }
 
 #[test]
@@ -45,7 +48,10 @@ fn singular_dependent_block_during_newton_is_typed() {
     kin.repartition(&mech, &mut ws, 0.0, &[0.9, -0.4]).unwrap();
     let mut q = [0.0, -0.5];
     let err = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap_err();
-    assert!(matches!(err, KinematicsError::SingularDependent { iteration: 1, .. }), "{err}");
+    assert!(
+        matches!(err, KinematicsError::SingularDependent { iteration: 1, .. }),
+        "{err}"
+    );
 }
 
 #[test]
@@ -178,8 +184,15 @@ fn duplicated_constraint_gives_minimum_norm_multipliers() {
     }
     // Algorithm P refuses the duplicated rows and names them.
     let mut ws = Workspace::new(dup.info()).unwrap();
-    let err = pfaff::Partition::compute(&dup, &mut ws, 0.0, &q, Default::default(), &Default::default())
-        .unwrap_err();
+    let err = pfaff::Partition::compute(
+        &dup,
+        &mut ws,
+        0.0,
+        &q,
+        Default::default(),
+        &Default::default(),
+    )
+    .unwrap_err();
     println!("{err}");
     assert!(matches!(
         err,
@@ -226,7 +239,10 @@ fn inconsistent_redundant_constraints_are_reported() {
         .accelerations(&mech, &mut ws, 0.0, &[0.6, -0.8], &[0.0; 2], &mut a, &mut l)
         .unwrap_err();
     println!("{err}");
-    assert!(matches!(err, pfaff::DynamicsError::InconsistentRedundant { .. }));
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::InconsistentRedundant { .. }
+    ));
 }
 
 #[test]
@@ -236,7 +252,15 @@ fn non_finite_inputs_and_outputs_are_reported() {
     let mut d = Dynamics::new(mech.info(), DynamicsParams::default()).unwrap();
     let (mut a, mut l) = ([0.0; 2], [0.0; 1]);
     let err = d
-        .accelerations(&mech, &mut ws, 0.0, &[f64::NAN, -1.0], &[0.0; 2], &mut a, &mut l)
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[f64::NAN, -1.0],
+            &[0.0; 2],
+            &mut a,
+            &mut l,
+        )
         .unwrap_err();
     println!("{err}");
     assert!(matches!(
@@ -248,7 +272,15 @@ fn non_finite_inputs_and_outputs_are_reported() {
         })
     ));
     let err = d
-        .accelerations(&mech, &mut ws, 0.0, &[0.6, -0.8], &[f64::INFINITY, 0.0], &mut a, &mut l)
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[0.6, -0.8],
+            &[f64::INFINITY, 0.0],
+            &mut a,
+            &mut l,
+        )
         .unwrap_err();
     assert!(matches!(
         err,
@@ -266,14 +298,30 @@ fn non_finite_inputs_and_outputs_are_reported() {
     assert_eq!(l, [0.0]);
     assert!(a[0].abs() < 1e-15 && (a[1] + common::G).abs() < 1e-14);
     let err = d
-        .accelerations(&mech, &mut ws, 0.0, &[0.0, 0.0], &[1.0, 0.0], &mut a, &mut l)
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[0.0, 0.0],
+            &[1.0, 0.0],
+            &mut a,
+            &mut l,
+        )
         .unwrap_err();
     println!("{err}");
-    assert!(matches!(err, pfaff::DynamicsError::InconsistentRedundant { .. }));
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::InconsistentRedundant { .. }
+    ));
     let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
-    let err = kin.repartition(&mech, &mut ws, 0.0, &[0.0, 0.0]).unwrap_err();
+    let err = kin
+        .repartition(&mech, &mut ws, 0.0, &[0.0, 0.0])
+        .unwrap_err();
     println!("{err}");
-    assert!(matches!(err, PartitionError::RedundantHolonomic { rank: 0, .. }));
+    assert!(matches!(
+        err,
+        PartitionError::RedundantHolonomic { rank: 0, .. }
+    ));
     let err: pfaff::Error = err.into();
     assert!(err.to_string().contains("rod"));
 }

@@ -4,8 +4,8 @@ mod common;
 
 use common::Sleigh;
 use pfaff::{
-    Dynamics, DynamicsParams, Kinematics, KinematicsParams, Mechanism, MechanismExt,
-    Prescription, SolverPath, Workspace,
+    Dynamics, DynamicsParams, Kinematics, KinematicsParams, Mechanism, MechanismExt, Prescription,
+    SolverPath, Workspace,
 };
 
 #[test]
@@ -21,7 +21,8 @@ fn v11_partition_at_zero_heading() {
     assert!(gamma.contains(&"x") && gamma.contains(&"phi"));
     // K2: y' from the knife edge.
     let mut qd = [1.0, 0.0, 0.5];
-    kin.velocity(&mech, &mut ws, 0.0, &[0.0; 3], &mut qd).unwrap();
+    kin.velocity(&mech, &mut ws, 0.0, &[0.0; 3], &mut qd)
+        .unwrap();
     assert!((qd[1] - 0.15).abs() < 1e-15);
 }
 
@@ -47,9 +48,17 @@ fn v11_accelerations_match_the_closed_form() {
         // v̇ = cos φ ẍ + sin φ ÿ + (lateral velocity) ω, with lateral velocity a ω.
         let vdot = phi.cos() * qdd[0] + phi.sin() * qdd[1] + a * w * w;
         assert!((vdot - a * w * w).abs() < 1e-12, "vdot {vdot}");
-        assert!((qdd[2] + m * a * v * w / j).abs() < 1e-12, "wdot {}", qdd[2]);
+        assert!(
+            (qdd[2] + m * a * v * w / j).abs() < 1e-12,
+            "wdot {}",
+            qdd[2]
+        );
         // V16: λ_nh = −0.2173913043 for this body-frame state.
-        assert!((lambda[0] + 0.217_391_304_3).abs() < 1e-9, "lambda {}", lambda[0]);
+        assert!(
+            (lambda[0] + 0.217_391_304_3).abs() < 1e-9,
+            "lambda {}",
+            lambda[0]
+        );
     }
 }
 
@@ -87,7 +96,10 @@ fn v11_motion_from_augmented_accelerations() {
     };
     let mut y = [q[0], q[1], q[2], qd[0], qd[1], qd[2]];
     let h = 1e-3;
-    let expected = [(1.0, 1.014_200_804_33, 0.176_360_706_663), (2.0, 1.014_272_774_73, 0.188_903_202_544)];
+    let expected = [
+        (1.0, 1.014_200_804_33, 0.176_360_706_663),
+        (2.0, 1.014_272_774_73, 0.188_903_202_544),
+    ];
     let mut step = 0;
     for &(t_end, v_ref, phi_ref) in &expected {
         while (step as f64) * h < t_end - 1e-12 {
@@ -98,11 +110,16 @@ fn v11_motion_from_augmented_accelerations() {
             let k2 = f(&add(&y, &k1, h / 2.0));
             let k3 = f(&add(&y, &k2, h / 2.0));
             let k4 = f(&add(&y, &k3, h));
-            y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+            y = std::array::from_fn(|i| {
+                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
             step += 1;
         }
         let v = y[2].cos() * y[3] + y[2].sin() * y[4];
-        println!("t = {t_end}: v = {v} (ref {v_ref}), phi = {} (ref {phi_ref})", y[2]);
+        println!(
+            "t = {t_end}: v = {v} (ref {v_ref}), phi = {} (ref {phi_ref})",
+            y[2]
+        );
         assert!((v - v_ref).abs() < 1e-9);
         assert!((y[2] - phi_ref).abs() < 1e-9);
         let r = mech.residuals(0.0, &y[..3], &y[3..]);

@@ -6,10 +6,11 @@ use std::f64::consts::FRAC_PI_6;
 
 use common::SliderCrank;
 use pfaff::{
-    Dynamics, DynamicsParams, Kinematics, KinematicsParams, Mechanism, MechanismExt,
-    Preferences, Prescription, Workspace,
+    Dynamics, DynamicsParams, Kinematics, KinematicsParams, LinearSolver, Mechanism, MechanismExt,
+    Preferences, Prescription, SolverPath, Workspace,
 };
 
+#[allow(clippy::approx_constant)] // the table of math-spec V10, verbatim
 const Q: [f64; 9] = [
     0.043301270189,
     0.025,
@@ -125,19 +126,35 @@ fn v10_driven_velocities_and_accelerations() {
     let (mut q, mut qd) = perturbed_guess();
     q[2] += 0.01; // the driver now fixes phi1 too
     let report = kin
-        .assemble(&mech, &mut ws, 0.0, &mut q, &mut qd, &Prescription::default())
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription::default(),
+        )
         .unwrap();
     println!("V10 driven assembly: {report:?}");
     assert_eq!(kin.partition().unwrap().dependent().len(), 9);
     assert_close(&q, &Q, 1e-10, "q");
     assert_close(&qd, &QD, 1e-10, "qd");
-    let mut dynamics = Dynamics::new(info, DynamicsParams::default()).unwrap();
     let (mut qdd, mut lambda) = ([0.0; 9], [0.0; 9]);
-    let stats = dynamics
-        .accelerations(&mech, &mut ws, 0.0, &q, &qd, &mut qdd, &mut lambda)
-        .unwrap();
-    assert_eq!(stats.path, pfaff::SolverPath::Dense);
-    assert_close(&qdd, &QDD, 1e-9, "qdd");
+    for (solver, path) in [
+        (LinearSolver::Dense, SolverPath::Dense),
+        (LinearSolver::Sparse, SolverPath::Sparse),
+    ] {
+        let params = DynamicsParams {
+            solver,
+            ..Default::default()
+        };
+        let mut dynamics = Dynamics::new(info, params).unwrap();
+        let stats = dynamics
+            .accelerations(&mech, &mut ws, 0.0, &q, &qd, &mut qdd, &mut lambda)
+            .unwrap();
+        assert_eq!(stats.path, path);
+        assert_close(&qdd, &QDD, 1e-9, "qdd");
+    }
     // The multipliers balance the equations of motion: M q̈ + C_qᵀ λ = Q.
     let mut jac = vec![0.0; 81];
     mech.holonomic_jacobian_dense_inplace(0.0, &q, &mut jac);

@@ -13,7 +13,12 @@ const fn sym(name: &'static str) -> Symbol {
 const NO_PARAMS: &[Parameter] = &[];
 
 fn diag(n: usize) -> Pattern {
-    Box::leak((0..n as u32).map(|i| (i, i)).collect::<Vec<_>>().into_boxed_slice())
+    Box::leak(
+        (0..n as u32)
+            .map(|i| (i, i))
+            .collect::<Vec<_>>()
+            .into_boxed_slice(),
+    )
 }
 
 // ---------------------------------------------------------------------------------
@@ -241,10 +246,17 @@ impl Mechanism for SliderCrank {
         out[5] = b / 2.0 * s2 * w2;
     }
     fn kinetic_energy(&self, _t: f64, _q: &[f64], qd: &[f64]) -> f64 {
-        0.5 * self.mass.iter().zip(qd).map(|(m, v)| m * v * v).sum::<f64>()
+        0.5 * self
+            .mass
+            .iter()
+            .zip(qd)
+            .map(|(m, v)| m * v * v)
+            .sum::<f64>()
     }
     fn potential_energy(&self, _t: f64, q: &[f64]) -> f64 {
-        (0..3).map(|b| self.mass[3 * b + 1] * G * q[3 * b + 1]).sum()
+        (0..3)
+            .map(|b| self.mass[3 * b + 1] * G * q[3 * b + 1])
+            .sum()
     }
 }
 
