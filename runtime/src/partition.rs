@@ -77,7 +77,7 @@ pub enum PartitionError {
         t: f64,
         /// The constraints left without a pivot.
         constraints: Vec<&'static str>,
-        /// Smallest pivot found / largest entry.
+        /// Best pivot left at the stop / largest entry (below the tolerance).
         ratio: f64,
         /// Numerical rank of $C_q$.
         rank: usize,
@@ -91,7 +91,7 @@ pub enum PartitionError {
         t: f64,
         /// The constraints left without a pivot.
         constraints: Vec<&'static str>,
-        /// Smallest pivot found / largest entry.
+        /// Best pivot left at the stop / largest entry (below the tolerance).
         ratio: f64,
     },
     /// A coordinate asked to stay independent must be dependent.
@@ -273,10 +273,10 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         return Err(PartitionError::RedundantHolonomic {
             t,
             constraints: names(&elim.rows[ph1.rank..mh]),
-            ratio: if ph1.rank == 0 || ph1.scale == 0.0 {
-                0.0
+            ratio: if ph1.scale > 0.0 {
+                ph1.rejected / ph1.scale
             } else {
-                ph1.min_pivot / ph1.scale
+                0.0
             },
             rank: ph1.rank,
             rows: mh,
@@ -311,10 +311,10 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         return Err(PartitionError::RedundantNonholonomic {
             t,
             constraints: names(&elim.rows[mh + ph2.rank..m]),
-            ratio: if ph2.rank == 0 || ph2.scale == 0.0 {
-                0.0
+            ratio: if ph2.scale > 0.0 {
+                ph2.rejected / ph2.scale
             } else {
-                ph2.min_pivot / ph2.scale
+                0.0
             },
         });
     }

@@ -39,6 +39,8 @@ pub(crate) struct Phase {
     pub abs_det: f64,
     /// Position of the first pivot taken from an [`Tier::Allowed`] column, if any.
     pub first_allowed: Option<usize>,
+    /// Largest candidate left when the phase stopped early (0 otherwise).
+    pub rejected: f64,
 }
 
 impl Phase {
@@ -110,6 +112,7 @@ impl Elimination {
             min_pivot: f64::INFINITY,
             abs_det: 1.0,
             first_allowed: None,
+            rejected: 0.0,
         };
         let threshold = tol * scale;
         for k in k0..(k0 + count).min(row_end).min(n) {
@@ -134,6 +137,7 @@ impl Elimination {
                 out.first_allowed.get_or_insert(k);
                 best[1]
             } else {
+                out.rejected = best[0].0.max(best[1].0);
                 break;
             };
             self.swap_rows(k, ip);
