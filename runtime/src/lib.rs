@@ -12,6 +12,7 @@
 pub use pfaff_macros::mechanism;
 
 mod mechanism;
+pub mod ode;
 
 pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
 
