@@ -15,6 +15,8 @@
 //!   and [assembly](Kinematics::assemble) of consistent initial conditions.
 //! - [`Dynamics`]: accelerations and multipliers from the augmented system, dense or
 //!   sparse, with minimum-norm multipliers for redundant constraints.
+//! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
+//!   [`ode::OdeSystem`], with dense output, restarts and statistics.
 //! - [`Error`]: every module's error, joined.
 
 pub use pfaff_macros::mechanism;
@@ -26,6 +28,7 @@ mod ext;
 mod kinematics;
 mod linalg;
 mod mechanism;
+pub mod ode;
 mod partition;
 mod workspace;
 

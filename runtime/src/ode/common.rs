@@ -1,0 +1,208 @@
+//! Small kernels shared by the integrators: checked evaluation of the right-hand side,
+//! error norms, Hairer's initial step size and the stop-time rule.
+//!
+//! Input: slices of equal length $n$. Output: scalars or slices written in place.
+//! Invariants: nothing here allocates; every derivative that leaves [`eval`] is finite.
+
+use super::error::{OdeError, Quantity};
+use super::options::{OdeStats, Tolerances};
+use super::system::OdeSystem;
+
+/// Machine epsilon $2^{-52}$, the `UROUND` of Hairer's codes and the `u` of Shampine–Gordon.
+pub(crate) const UROUND: f64 = f64::EPSILON;
+
+/// Index of the first NaN or infinite entry.
+#[inline]
+pub(crate) fn first_non_finite(x: &[f64]) -> Option<usize> {
+    x.iter().position(|v| !v.is_finite())
+}
+
+/// Checks that a state is finite.
+pub(crate) fn check_state(t: f64, y: &[f64]) -> Result<(), OdeError> {
+    match first_non_finite(y) {
+        Some(component) => Err(OdeError::NonFinite {
+            t,
+            component,
+            quantity: Quantity::State,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks the length of a slice against the dimension.
+#[inline]
+pub(crate) fn check_len(expected: usize, found: usize) -> Result<(), OdeError> {
+    if expected == found {
+        Ok(())
+    } else {
+        Err(OdeError::DimensionMismatch { expected, found })
+    }
+}
+
+/// Evaluates $f(t, y)$ into `dy`, counts it, and checks the output for NaN and infinity.
+#[inline]
+pub(crate) fn eval<S: OdeSystem + ?Sized>(
+    sys: &mut S,
+    stats: &mut OdeStats,
+    t: f64,
+    y: &[f64],
+    dy: &mut [f64],
+) -> Result<(), OdeError> {
+    stats.rhs_evals += 1;
+    sys.rhs(t, y, dy)
+        .map_err(|source| OdeError::Rhs { t, source })?;
+    match first_non_finite(dy) {
+        Some(component) => Err(OdeError::NonFinite {
+            t,
+            component,
+            quantity: Quantity::Derivative,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The mixed RMS norm of a local error estimate `err`,
+/// $\sqrt{\frac1n\sum_i (e_i/s_i)^2}$ with $s_i = \text{atol}_i + \text{rtol}\max(|y_i|, |\hat y_i|)$.
+#[inline]
+pub(crate) fn rms_norm(tol: &Tolerances, err: &[f64], y: &[f64], y_new: &[f64]) -> f64 {
+    let mut sum = 0.0;
+    for (i, ((e, a), b)) in err.iter().zip(y).zip(y_new).enumerate() {
+        let sk = tol.atol(i) + tol.rtol * a.abs().max(b.abs());
+        sum += (e / sk) * (e / sk);
+    }
+    (sum / err.len().max(1) as f64).sqrt()
+}
+
+/// Hairer's `HINIT` (dopri5.f, dop853.f): a first step size $h$ such that
+/// $h^{p}\max(\|f_0\|, \|f'\|) \approx 0.01$, where $f'$ is estimated from one explicit
+/// Euler step. Costs one evaluation; uses `y1` and `f1` as scratch.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn hinit<S: OdeSystem + ?Sized>(
+    sys: &mut S,
+    stats: &mut OdeStats,
+    tol: &Tolerances,
+    order: i32,
+    h_max: f64,
+    dir: f64,
+    (t, y, f0): (f64, &[f64], &[f64]),
+    y1: &mut [f64],
+    f1: &mut [f64],
+) -> Result<f64, OdeError> {
+    let sk = |i: usize| tol.atol(i) + tol.rtol * y[i].abs();
+    let (mut dnf, mut dny) = (0.0, 0.0);
+    for i in 0..y.len() {
+        dnf += (f0[i] / sk(i)).powi(2);
+        dny += (y[i] / sk(i)).powi(2);
+    }
+    let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
+        1e-6
+    } else {
+        (dny / dnf).sqrt() * 0.01
+    };
+    h = h.min(h_max) * dir;
+    for i in 0..y.len() {
+        y1[i] = y[i] + h * f0[i];
+    }
+    eval(sys, stats, t + h, y1, f1)?;
+    let mut der2 = 0.0;
+    for i in 0..y.len() {
+        der2 += ((f1[i] - f0[i]) / sk(i)).powi(2);
+    }
+    let der2 = der2.sqrt() / h.abs();
+    let der12 = der2.max(dnf.sqrt());
+    let h1 = if der12 <= 1e-15 {
+        (h.abs() * 1e-3).max(1e-6)
+    } else {
+        (0.01 / der12).powf(1.0 / f64::from(order))
+    };
+    Ok((100.0 * h.abs()).min(h1).min(h_max) * dir)
+}
+
+/// Where a step of size `h` from `t` may go given a stop time: returns the step size to
+/// use and whether it lands exactly on `t_stop`. As in Hairer's codes, a step that
+/// would end within 1% short of `t_stop` is stretched to it.
+#[inline]
+pub(crate) fn limit_to_stop(t: f64, h: f64, t_stop: Option<f64>) -> (f64, bool) {
+    match t_stop {
+        Some(ts) if (t + 1.01 * h - ts) * h.signum() >= 0.0 => (ts - t, true),
+        _ => (h, false),
+    }
+}
+
+/// Validates a stop time against the direction `dir`; `Ok(true)` when already there.
+#[inline]
+pub(crate) fn check_stop(t: f64, dir: f64, t_stop: Option<f64>) -> Result<bool, OdeError> {
+    match t_stop {
+        Some(ts) if ts.is_nan() || (ts - t) * dir < 0.0 => {
+            Err(OdeError::StopBehind { t, t_stop: ts })
+        }
+        Some(ts) => Ok(ts == t),
+        None => Ok(false),
+    }
+}
+
+/// Checks that `t` lies in the step `[t0, t1]` (either orientation), allowing for
+/// round-off in the end points.
+#[inline]
+pub(crate) fn check_in_step(t: f64, t0: f64, t1: f64) -> Result<(), OdeError> {
+    let (lo, hi) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+    let slack = 4.0 * UROUND * lo.abs().max(hi.abs()) + 1e-12 * (hi - lo);
+    if t >= lo - slack && t <= hi + slack {
+        Ok(())
+    } else {
+        Err(OdeError::OutsideStep {
+            t,
+            t_prev: t0,
+            t_cur: t1,
+        })
+    }
+}
+
+/// The step-size controller of Hairer's `dopri5.f` and `dop853.f`: an integral
+/// controller with Lund stabilization (a PI controller),
+/// $$h_{\text{new}} = h\Big/\operatorname{clamp}\!\Big(\frac{\text{err}^{\alpha}}
+/// {\text{err}_{\text{old}}^{\beta}\,\text{safe}},\ \tfrac1{\text{fac}_2},\ \tfrac1{\text{fac}_1}\Big),$$
+/// with $\alpha = 1/q - \beta\,w$ ($q$ the order of the error estimate plus one).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PiController {
+    expo1: f64,
+    beta: f64,
+    safe: f64,
+    facc1: f64,
+    facc2: f64,
+    facold: f64,
+}
+
+impl PiController {
+    /// `expo1` is $\alpha$ above; `fac1` bounds the decrease, `fac2` the increase.
+    pub(crate) fn new(expo1: f64, beta: f64, safe: f64, fac1: f64, fac2: f64) -> Self {
+        Self {
+            expo1,
+            beta,
+            safe,
+            facc1: 1.0 / fac1,
+            facc2: 1.0 / fac2,
+            facold: 1e-4,
+        }
+    }
+
+    /// Forgets the previous error (at reset).
+    pub(crate) fn reset(&mut self) {
+        self.facold = 1e-4;
+    }
+
+    /// The next step size after an attempt of size `h` with error `err` (a NaN or an
+    /// infinite error counts as a huge one). Returns `(h_new, accepted)`.
+    pub(crate) fn control(&mut self, err: f64, h: f64) -> (f64, bool) {
+        let err = if err.is_finite() { err } else { f64::MAX };
+        let fac11 = err.powf(self.expo1);
+        if err <= 1.0 {
+            let fac = fac11 / self.facold.powf(self.beta);
+            let fac = (fac / self.safe).min(self.facc1).max(self.facc2);
+            self.facold = err.max(1e-4);
+            (h / fac, true)
+        } else {
+            (h / self.facc1.min(fac11 / self.safe), false)
+        }
+    }
+}
