@@ -14,8 +14,15 @@ fn main() {
     }
     let file: syn::File = syn::parse_str(&src).expect("a Rust file");
     for item in file.items {
-        let syn::Item::Mod(mut m) = item else { continue };
-        let Some(pos) = m.attrs.iter().position(|a| a.path().segments.last().is_some_and(|s| s.ident == "mechanism")) else {
+        let syn::Item::Mod(mut m) = item else {
+            continue;
+        };
+        let Some(pos) = m.attrs.iter().position(|a| {
+            a.path()
+                .segments
+                .last()
+                .is_some_and(|s| s.ident == "mechanism")
+        }) else {
             continue;
         };
         m.attrs.remove(pos);

@@ -44,7 +44,12 @@ impl Ctxt {
 
     /// All recorded errors combined, or `Ok` when there are none.
     pub fn check(&self) -> syn::Result<()> {
-        let mut errors = self.errors.borrow_mut().drain(..).collect::<Vec<_>>().into_iter();
+        let mut errors = self
+            .errors
+            .borrow_mut()
+            .drain(..)
+            .collect::<Vec<_>>()
+            .into_iter();
         let Some(mut combined) = errors.next() else {
             return Ok(());
         };
@@ -57,7 +62,10 @@ impl Ctxt {
 
 /// The closest name to `unknown` among `candidates`, when it is close enough to be
 /// a plausible typo (edit distance at most a third of the length, and at most 3).
-pub fn suggest<'a>(unknown: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn suggest<'a>(
+    unknown: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     let limit = (unknown.chars().count() / 3).clamp(1, 3);
     candidates
         .into_iter()

@@ -1,4 +1,3 @@
-<<<<<<< HEAD
 //! The generator behind `#[pfaff::mechanism]`: a pipeline of stages on `proc_macro2`.
 //!
 //! ```text
@@ -73,13 +72,4 @@ pub fn expand(args: TokenStream, input: TokenStream) -> TokenStream {
             out
         }
     }
-=======
-//! The generator behind `#[pfaff::mechanism]`.
-pub fn expand(
-    args: proc_macro2::TokenStream,
-    input: proc_macro2::TokenStream,
-) -> proc_macro2::TokenStream {
-    let _ = args;
-    input
->>>>>>> integ
 }

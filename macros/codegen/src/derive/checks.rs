@@ -26,7 +26,10 @@ pub fn param_defaults(cx: &Ctxt, model: &Model, tr: &mut Translator<'_>) -> Vec<
         match v {
             Some(v) if v.is_finite() => values.push(v),
             Some(v) => {
-                cx.error_spanned_by(&p.default, format!("the default of `{}` evaluates to {v}", p.name));
+                cx.error_spanned_by(
+                    &p.default,
+                    format!("the default of `{}` evaluates to {v}", p.name),
+                );
                 values.push(0.0);
             }
             None => values.push(0.0),
@@ -136,7 +139,10 @@ pub fn not_quadratic(cx: &Ctxt, model: &Model, g: &mut Graph, m: ExprId, i: usiz
         })
         .map(|k| velocity_name(model, k))
         .unwrap_or_default();
-    let span = model.kinetic.as_ref().map_or_else(|| model.ident.span(), |k| k.name.span());
+    let span = model
+        .kinetic
+        .as_ref()
+        .map_or_else(|| model.ident.span(), |k| k.name.span());
     cx.error_at(
         span,
         format!(
@@ -190,7 +196,10 @@ pub fn virtual_work(
             return None;
         }
         if out.iter().all(|&c| g.is_zero(c)) {
-            cx.error_spanned_by(&item.name, format!("virtual work `{}` is identically zero", item.name));
+            cx.error_spanned_by(
+                &item.name,
+                format!("virtual work `{}` is identically zero", item.name),
+            );
             return None;
         }
     }
@@ -200,13 +209,19 @@ pub fn virtual_work(
 /// Rejects trivial holonomic constraints. Returns whether the constraint is usable.
 pub fn holonomic(cx: &Ctxt, item: &FnItem, g: &Graph, h: ExprId) -> bool {
     if g.is_zero(h) {
-        cx.error_spanned_by(&item.name, format!("holonomic constraint `{}` is identically zero", item.name));
+        cx.error_spanned_by(
+            &item.name,
+            format!("holonomic constraint `{}` is identically zero", item.name),
+        );
         return false;
     }
     if !g.deps(h).has(Deps::Q) {
         cx.error_spanned_by(
             &item.name,
-            format!("holonomic constraint `{}` does not depend on the coordinates", item.name),
+            format!(
+                "holonomic constraint `{}` does not depend on the coordinates",
+                item.name
+            ),
         );
         return false;
     }
@@ -235,7 +250,13 @@ pub fn not_linear(cx: &Ctxt, model: &Model, g: &mut Graph, r: usize, d: ExprId) 
 /// Rejects trivial non-holonomic constraints. Returns whether the constraint is usable.
 pub fn nonholonomic(cx: &Ctxt, item: &FnItem, g: &Graph, nh: ExprId, no_velocity: bool) -> bool {
     if g.is_zero(nh) {
-        cx.error_spanned_by(&item.name, format!("non-holonomic constraint `{}` is identically zero", item.name));
+        cx.error_spanned_by(
+            &item.name,
+            format!(
+                "non-holonomic constraint `{}` is identically zero",
+                item.name
+            ),
+        );
         return false;
     }
     if no_velocity {

@@ -80,7 +80,11 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
 
     let param_defaults = checks::param_defaults(cx, model, &mut tr);
 
-    let initial = if model.coords.iter().any(|c| c.q0.is_some() || c.qd0.is_some()) {
+    let initial = if model
+        .coords
+        .iter()
+        .any(|c| c.q0.is_some() || c.qd0.is_some())
+    {
         let mut q0 = Vec::new();
         let mut qd0 = Vec::new();
         for c in &model.coords {
@@ -158,7 +162,11 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 return None;
             }
             if !g.is_zero(m) {
-                mass.push(Entry { row: idx(i), col: idx(j), expr: m });
+                mass.push(Entry {
+                    row: idx(i),
+                    col: idx(j),
+                    expr: m,
+                });
             }
         }
     }
@@ -199,7 +207,11 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         for j in 0..n {
             let d = diff::differentiate(g, h, Var::Q(idx(j)));
             if !g.is_zero(d) {
-                cq.push(Entry { row: idx(r), col: idx(j), expr: d });
+                cq.push(Entry {
+                    row: idx(r),
+                    col: idx(j),
+                    expr: d,
+                });
                 rate_terms.push(g.mul(vec![d, qv[j]]));
             }
         }
@@ -228,7 +240,11 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 return None;
             }
             if !g.is_zero(d) {
-                row.push(Entry { row: idx(r), col: idx(j), expr: d });
+                row.push(Entry {
+                    row: idx(r),
+                    col: idx(j),
+                    expr: d,
+                });
             }
         }
         if checking && !checks::nonholonomic(cx, &model.nonholonomic[r], g, nh, row.is_empty()) {

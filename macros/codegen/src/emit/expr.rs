@@ -141,7 +141,8 @@ impl Printer<'_> {
     }
 
     fn sum(&self, terms: &[ExprId]) -> (TokenStream, Prec) {
-        let mut parts: Vec<(bool, TokenStream, Prec)> = terms.iter().map(|&t| self.signed_term(t)).collect();
+        let mut parts: Vec<(bool, TokenStream, Prec)> =
+            terms.iter().map(|&t| self.signed_term(t)).collect();
         // Positive terms first reads better: `a - b` rather than `-b + a`.
         parts.sort_by_key(|p| p.0);
         let mut out = TokenStream::new();
@@ -187,7 +188,13 @@ impl Printer<'_> {
         let (mut out, mut prec) = if num.len() == 1 {
             num.pop().expect("one factor")
         } else {
-            (join(num.into_iter().map(|(ts, p)| wrap(ts, p, Prec::Unary)), &quote!(*)), Prec::Product)
+            (
+                join(
+                    num.into_iter().map(|(ts, p)| wrap(ts, p, Prec::Unary)),
+                    &quote!(*),
+                ),
+                Prec::Product,
+            )
         };
         if !den.is_empty() {
             out = wrap(out, prec, Prec::Product);

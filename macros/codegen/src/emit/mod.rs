@@ -45,9 +45,9 @@ impl ModelNames {
                 Ident::new(&name, Span::call_site())
             })
             .collect();
-        let clash = declared
-            .iter()
-            .any(|n| n.len() > 1 && n.starts_with('t') && n[1..].bytes().all(|b| b.is_ascii_digit()));
+        let clash = declared.iter().any(|n| {
+            n.len() > 1 && n.starts_with('t') && n[1..].bytes().all(|b| b.is_ascii_digit())
+        });
         ModelNames {
             coords: model.coords.iter().map(|c| c.name.clone()).collect(),
             velocities,
@@ -157,7 +157,10 @@ fn entries(e: &[Entry]) -> Vec<ExprId> {
 
 fn pattern(e: &[Entry]) -> TokenStream {
     let items = e.iter().map(|e| {
-        let (r, c) = (Literal::u32_unsuffixed(e.row), Literal::u32_unsuffixed(e.col));
+        let (r, c) = (
+            Literal::u32_unsuffixed(e.row),
+            Literal::u32_unsuffixed(e.col),
+        );
         quote!((#r, #c))
     });
     quote!(&[#(#items),*])
@@ -185,7 +188,11 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
 
     let pnames = &names.params;
     let pdocs: Vec<TokenStream> = model.params.iter().map(|p| doc_attr(&p.docs)).collect();
-    let pdefaults: Vec<TokenStream> = d.param_defaults.iter().map(|&v| expr::literal(v).0).collect();
+    let pdefaults: Vec<TokenStream> = d
+        .param_defaults
+        .iter()
+        .map(|&v| expr::literal(v).0)
+        .collect();
     let param_count = model.params.len();
     let param_idx: Vec<Literal> = (0..param_count).map(Literal::usize_unsuffixed).collect();
 
@@ -196,8 +203,18 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         quote!(&[#(#items),*])
     };
     let coordinates = symbols(&mut model.coords.iter().map(|c| (c.name.to_string(), &c.docs)));
-    let holonomic = symbols(&mut model.holonomic.iter().map(|c| (c.name.to_string(), &c.docs)));
-    let nonholonomic = symbols(&mut model.nonholonomic.iter().map(|c| (c.name.to_string(), &c.docs)));
+    let holonomic = symbols(
+        &mut model
+            .holonomic
+            .iter()
+            .map(|c| (c.name.to_string(), &c.docs)),
+    );
+    let nonholonomic = symbols(
+        &mut model
+            .nonholonomic
+            .iter()
+            .map(|c| (c.name.to_string(), &c.docs)),
+    );
     let parameters: Vec<TokenStream> = model
         .params
         .iter()
@@ -210,7 +227,12 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     let mass_pattern = pattern(&d.mass);
     let cq_pattern = pattern(&d.cq);
     let g_pattern = pattern(&d.gm);
-    let (tm, tf, th, tn) = (d.time.mass, d.time.forces, d.time.holonomic, d.time.nonholonomic);
+    let (tm, tf, th, tn) = (
+        d.time.mass,
+        d.time.forces,
+        d.time.holonomic,
+        d.time.nonholonomic,
+    );
     let homogeneous = d.homogeneous;
     let conservative = d.conservative;
 
@@ -232,11 +254,23 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
             fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) { #code }
         });
     }
-    fns.extend(vector_fn(g, &names, "mass_matrix", &entries(&d.mass), false));
+    fns.extend(vector_fn(
+        g,
+        &names,
+        "mass_matrix",
+        &entries(&d.mass),
+        false,
+    ));
     fns.extend(vector_fn(g, &names, "forces", &d.forces, true));
     if !d.c.is_empty() {
         fns.extend(vector_fn(g, &names, "holonomic", &d.c, false));
-        fns.extend(vector_fn(g, &names, "holonomic_jacobian", &entries(&d.cq), false));
+        fns.extend(vector_fn(
+            g,
+            &names,
+            "holonomic_jacobian",
+            &entries(&d.cq),
+            false,
+        ));
         if any_nonzero(g, &d.ct) {
             fns.extend(vector_fn(g, &names, "holonomic_rate", &d.ct, false));
         }
@@ -245,12 +279,24 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         }
     }
     if !d.gb.is_empty() {
-        fns.extend(vector_fn(g, &names, "nonholonomic_matrix", &entries(&d.gm), false));
+        fns.extend(vector_fn(
+            g,
+            &names,
+            "nonholonomic_matrix",
+            &entries(&d.gm),
+            false,
+        ));
         if any_nonzero(g, &d.gb) {
             fns.extend(vector_fn(g, &names, "nonholonomic_bias", &d.gb, false));
         }
         if any_nonzero(g, &d.gamma_nh) {
-            fns.extend(vector_fn(g, &names, "nonholonomic_gamma", &d.gamma_nh, true));
+            fns.extend(vector_fn(
+                g,
+                &names,
+                "nonholonomic_gamma",
+                &d.gamma_nh,
+                true,
+            ));
         }
     }
     {
@@ -272,8 +318,10 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     }
 
     let model_doc = format!(" The `{name_str}` mechanism with its parameters.");
-    let params_doc = format!(" Parameters of `{name_str}`, with the defaults declared in the model.");
-    let info_doc = format!(" Names, sizes, sparsity patterns and structural flags of `{name_str}`.");
+    let params_doc =
+        format!(" Parameters of `{name_str}`, with the defaults declared in the model.");
+    let info_doc =
+        format!(" Names, sizes, sparsity patterns and structural flags of `{name_str}`.");
     let get = if param_count == 0 {
         quote!(::core::panic!("`{}` has no parameters (index {})", #name_str, index))
     } else {
@@ -285,7 +333,9 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         }
     };
     let set = if param_count == 0 {
-        quote!(::core::panic!("`{}` has no parameters (index {}, value {})", #name_str, index, value))
+        quote!(
+            ::core::panic!("`{}` has no parameters (index {}, value {})", #name_str, index, value)
+        )
     } else {
         quote! {
             match index {

@@ -110,7 +110,10 @@ impl<'a> Translator<'a> {
     pub fn matrix_block(&mut self, block: &syn::Block) -> Option<Vec<Vec<(ExprId, syn::Expr)>>> {
         let (stmts, tail) = self.split_block(block)?;
         let syn::Expr::Array(rows) = tail else {
-            self.cx.error_spanned_by(tail, "`mass_matrix` ends with an array of rows: `[[..], [..]]`");
+            self.cx.error_spanned_by(
+                tail,
+                "`mass_matrix` ends with an array of rows: `[[..], [..]]`",
+            );
             return None;
         };
         self.with_locals(Context::MassMatrix, stmts, |t| {
@@ -183,25 +186,33 @@ impl<'a> Translator<'a> {
             return false;
         };
         let ident = match &local.pat {
-            syn::Pat::Ident(p) if p.by_ref.is_none() && p.mutability.is_none() && p.subpat.is_none() => &p.ident,
+            syn::Pat::Ident(p)
+                if p.by_ref.is_none() && p.mutability.is_none() && p.subpat.is_none() =>
+            {
+                &p.ident
+            }
             syn::Pat::Type(pt) => match &*pt.pat {
                 syn::Pat::Ident(p) if p.subpat.is_none() => &p.ident,
                 other => {
-                    self.cx.error_spanned_by(other, "expected a name: `let name = ..;`");
+                    self.cx
+                        .error_spanned_by(other, "expected a name: `let name = ..;`");
                     return false;
                 }
             },
             other => {
-                self.cx.error_spanned_by(other, "expected a name: `let name = ..;`");
+                self.cx
+                    .error_spanned_by(other, "expected a name: `let name = ..;`");
                 return false;
             }
         };
         let Some(init) = &local.init else {
-            self.cx.error_spanned_by(local, "a `let` binding needs a value");
+            self.cx
+                .error_spanned_by(local, "a `let` binding needs a value");
             return false;
         };
         if let Some((_, diverge)) = &init.diverge {
-            self.cx.error_spanned_by(diverge, "`let .. else` is not supported here");
+            self.cx
+                .error_spanned_by(diverge, "`let .. else` is not supported here");
             return false;
         }
         match self.expr(&init.expr) {
@@ -227,7 +238,10 @@ impl<'a> Translator<'a> {
                 _ => {
                     self.cx.error_spanned_by(
                         u.op,
-                        format!("unsupported operator `{}`, expected `-`", u.op.to_token_stream()),
+                        format!(
+                            "unsupported operator `{}`, expected `-`",
+                            u.op.to_token_stream()
+                        ),
                     );
                     None
                 }
@@ -289,13 +303,19 @@ impl<'a> Translator<'a> {
             return self.name(ident);
         }
         // `std::f64::consts::PI` and friends.
-        let segs: Vec<String> = p.path.segments.iter().map(|s| s.ident.to_string()).collect();
+        let segs: Vec<String> = p
+            .path
+            .segments
+            .iter()
+            .map(|s| s.ident.to_string())
+            .collect();
         if segs.len() >= 2 && segs[segs.len() - 2] == "consts" {
             if let Some(v) = kw::constant(&segs[segs.len() - 1]) {
                 return Some(self.g.constant(v));
             }
         }
-        self.cx.error_spanned_by(p, "unknown path; use the names declared in the mechanism");
+        self.cx
+            .error_spanned_by(p, "unknown path; use the names declared in the mechanism");
         None
     }
 
@@ -333,7 +353,10 @@ impl<'a> Translator<'a> {
             if !self.ctx.allows_state() {
                 self.cx.error_spanned_by(
                     ident,
-                    format!("time `t` in {}: only parameters and constants are allowed here", self.ctx.describe()),
+                    format!(
+                        "time `t` in {}: only parameters and constants are allowed here",
+                        self.ctx.describe()
+                    ),
                 );
                 return None;
             }
@@ -343,7 +366,8 @@ impl<'a> Translator<'a> {
             return Some(self.g.constant(v));
         }
         if self.model.definitions.iter().any(|d| d.name == s) {
-            self.cx.error_spanned_by(ident, format!("`{s}` is a definition: write `{s}()`"));
+            self.cx
+                .error_spanned_by(ident, format!("`{s}` is a definition: write `{s}()`"));
             return None;
         }
         let mut names: Vec<String> = self.locals.iter().map(|(n, _)| n.clone()).collect();
@@ -354,7 +378,8 @@ impl<'a> Translator<'a> {
         let hint = suggest(&s, names.iter().map(String::as_str))
             .map(|n| format!("; did you mean `{n}`?"))
             .unwrap_or_default();
-        self.cx.error_spanned_by(ident, format!("unknown name `{s}`{hint}"));
+        self.cx
+            .error_spanned_by(ident, format!("unknown name `{s}`{hint}"));
         None
     }
 
@@ -381,7 +406,11 @@ impl<'a> Translator<'a> {
                 &m.method,
                 format!(
                     "unsupported function `{name}`, expected one of {}{hint}",
-                    METHODS[1..].iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+                    METHODS[1..]
+                        .iter()
+                        .map(|s| format!("`{s}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             );
             return None;
@@ -389,7 +418,10 @@ impl<'a> Translator<'a> {
         if args.len() != want {
             self.cx.error_spanned_by(
                 &m.args,
-                format!("`{name}` takes {want} argument{}", if want == 1 { "" } else { "s" }),
+                format!(
+                    "`{name}` takes {want} argument{}",
+                    if want == 1 { "" } else { "s" }
+                ),
             );
             return None;
         }
@@ -397,7 +429,11 @@ impl<'a> Translator<'a> {
             let n = self.integer(args[0]);
             return Some(self.g.powi(recv?, n?));
         }
-        let arg = if want == 1 { Some(self.expr(args[0])) } else { None };
+        let arg = if want == 1 {
+            Some(self.expr(args[0]))
+        } else {
+            None
+        };
         let recv = recv?;
         Some(match name.as_str() {
             "powf" => {
@@ -426,7 +462,8 @@ impl<'a> Translator<'a> {
             other => (false, other),
         };
         if let syn::Expr::Lit(syn::ExprLit {
-            lit: syn::Lit::Int(i), ..
+            lit: syn::Lit::Int(i),
+            ..
         }) = inner
         {
             if let Ok(v) = i.base10_parse::<i32>() {
@@ -443,7 +480,8 @@ impl<'a> Translator<'a> {
     /// `x.dot()`: the velocity of coordinate `x`.
     fn velocity(&mut self, m: &syn::ExprMethodCall) -> Option<ExprId> {
         if !m.args.is_empty() {
-            self.cx.error_spanned_by(&m.args, "`.dot()` takes no arguments");
+            self.cx
+                .error_spanned_by(&m.args, "`.dot()` takes no arguments");
             return None;
         }
         let coord = match &*m.receiver {
@@ -460,11 +498,17 @@ impl<'a> Translator<'a> {
                     let known = self.locals.iter().any(|(n, _)| id == n)
                         || self.model.param_index(&id.to_string()).is_some();
                     if !known {
-                        let names: Vec<String> = self.model.coords.iter().map(|c| c.name.to_string()).collect();
+                        let names: Vec<String> = self
+                            .model
+                            .coords
+                            .iter()
+                            .map(|c| c.name.to_string())
+                            .collect();
                         let hint = suggest(&id.to_string(), names.iter().map(String::as_str))
                             .map(|n| format!("; did you mean `{n}`?"))
                             .unwrap_or_default();
-                        self.cx.error_spanned_by(id, format!("unknown coordinate `{id}`{hint}"));
+                        self.cx
+                            .error_spanned_by(id, format!("unknown coordinate `{id}`{hint}"));
                         return None;
                     }
                 }
@@ -509,21 +553,31 @@ impl<'a> Translator<'a> {
             let hint = if Func::from_name(&s).is_some() || s == "atan2" || s.starts_with("pow") {
                 format!("; write functions as methods, as in `x.{s}()`")
             } else {
-                let defs: Vec<String> = self.model.definitions.iter().map(|d| d.name.to_string()).collect();
+                let defs: Vec<String> = self
+                    .model
+                    .definitions
+                    .iter()
+                    .map(|d| d.name.to_string())
+                    .collect();
                 suggest(&s, defs.iter().map(String::as_str))
                     .map(|n| format!("; did you mean `{n}()`?"))
                     .unwrap_or_default()
             };
-            self.cx.error_spanned_by(ident, format!("unknown function `{s}`{hint}"));
+            self.cx
+                .error_spanned_by(ident, format!("unknown function `{s}`{hint}"));
             return None;
         };
         if !c.args.is_empty() {
-            self.cx.error_spanned_by(&c.args, format!("definition `{s}` takes no arguments"));
+            self.cx
+                .error_spanned_by(&c.args, format!("definition `{s}` takes no arguments"));
         }
         if !self.ctx.allows_state() {
             self.cx.error_spanned_by(
                 ident,
-                format!("definition `{s}()` in {}: only parameters and constants are allowed here", self.ctx.describe()),
+                format!(
+                    "definition `{s}()` in {}: only parameters and constants are allowed here",
+                    self.ctx.describe()
+                ),
             );
             return None;
         }
@@ -554,12 +608,16 @@ impl<'a> Translator<'a> {
         if self.ctx != Context::VirtualWork {
             self.cx.error_spanned_by(
                 c,
-                format!("`delta(..)` in {}: variations belong in `#[virtual_work]` functions", self.ctx.describe()),
+                format!(
+                    "`delta(..)` in {}: variations belong in `#[virtual_work]` functions",
+                    self.ctx.describe()
+                ),
             );
             return None;
         }
         if c.args.len() != 1 {
-            self.cx.error_spanned_by(c, "`delta` takes one argument, as in `delta(x)`");
+            self.cx
+                .error_spanned_by(c, "`delta` takes one argument, as in `delta(x)`");
             return None;
         }
         let e = self.expr(&c.args[0])?;

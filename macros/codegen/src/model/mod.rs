@@ -115,13 +115,26 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
                     default,
                 });
             }
-            parse::Item::Coord { name, docs, q0, qd0 } => {
+            parse::Item::Coord {
+                name,
+                docs,
+                q0,
+                qd0,
+            } => {
                 declare(&name);
-                model.coords.push(Coord { name, docs, q0, qd0 });
+                model.coords.push(Coord {
+                    name,
+                    docs,
+                    q0,
+                    qd0,
+                });
             }
             parse::Item::Fn(f) => {
                 if f.name == kw::DELTA {
-                    cx.error_spanned_by(&f.name, "`delta` is reserved for variations and cannot name a function");
+                    cx.error_spanned_by(
+                        &f.name,
+                        "`delta` is reserved for variations and cannot name a function",
+                    );
                 }
                 declare(&f.name);
                 let slot = match &f.role {
@@ -160,7 +173,11 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         match model.coord_index(&target.to_string()) {
             Some(i) => model.forces.push((i, f)),
             None => {
-                let names = model.coords.iter().map(|c| c.name.to_string()).collect::<Vec<_>>();
+                let names = model
+                    .coords
+                    .iter()
+                    .map(|c| c.name.to_string())
+                    .collect::<Vec<_>>();
                 let hint = suggest(&target.to_string(), names.iter().map(String::as_str))
                     .map(|s| format!("; did you mean `{s}`?"))
                     .unwrap_or_default();

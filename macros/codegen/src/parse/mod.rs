@@ -300,7 +300,10 @@ fn parse_fn(cx: &Ctxt, f: syn::ItemFn) -> Option<FnItem> {
             continue;
         };
         if !matches!(attr.meta, syn::Meta::Path(_)) && !matches!(r, Role::Force(_)) {
-            cx.error_spanned_by(attr, format!("`#[{}]` takes no arguments", path.to_token_stream()));
+            cx.error_spanned_by(
+                attr,
+                format!("`#[{}]` takes no arguments", path.to_token_stream()),
+            );
         }
         if role.is_some() {
             cx.error_spanned_by(attr, "a function has at most one role attribute");
@@ -326,7 +329,8 @@ fn parse_fn(cx: &Ctxt, f: syn::ItemFn) -> Option<FnItem> {
         (None, None) => Role::Definition,
     };
     match (&role, &f.sig.output) {
-        (Role::MassMatrix, syn::ReturnType::Type(_, ty)) if matches!(**ty, syn::Type::Array(_)) => {}
+        (Role::MassMatrix, syn::ReturnType::Type(_, ty)) if matches!(**ty, syn::Type::Array(_)) => {
+        }
         (Role::MassMatrix, out) => cx.error_at(
             sig_span(&f.sig, out),
             "`mass_matrix` returns a square array: `fn mass_matrix() -> [[f64; N]; N]`",

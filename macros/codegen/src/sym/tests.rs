@@ -86,7 +86,8 @@ fn random_expr(g: &mut Graph, rng: &mut Rng, depth: u32) -> ExprId {
         }
         8 => {
             let a = random_expr(g, rng, depth - 1);
-            let f = [Func::Sin, Func::Cos, Func::Atan, Func::Tanh, Func::Sinh][rng.below(5) as usize];
+            let f =
+                [Func::Sin, Func::Cos, Func::Atan, Func::Tanh, Func::Sinh][rng.below(5) as usize];
             g.call(f, a)
         }
         9 => {
@@ -209,9 +210,15 @@ fn simplified_and_unsimplified_expressions_evaluate_equal() {
             );
             checked += 1;
         }
-        assert!(canon.len() <= raw.len() + 8, "simplification does not blow up the graph");
+        assert!(
+            canon.len() <= raw.len() + 8,
+            "simplification does not blow up the graph"
+        );
     }
-    assert!(checked > 1000, "enough finite samples were compared: {checked}");
+    assert!(
+        checked > 1000,
+        "enough finite samples were compared: {checked}"
+    );
 }
 
 #[test]
@@ -277,9 +284,14 @@ fn building_is_deterministic() {
         let mut rng = Rng(7);
         let mut g = Graph::new();
         let roots: Vec<ExprId> = (0..20).map(|_| random_expr(&mut g, &mut rng, 5)).collect();
-        let d: Vec<ExprId> = roots.iter().map(|&r| diff::differentiate(&mut g, r, Var::Q(1))).collect();
+        let d: Vec<ExprId> = roots
+            .iter()
+            .map(|&r| diff::differentiate(&mut g, r, Var::Q(1)))
+            .collect();
         let name = |v: Var| format!("{v:?}");
-        d.iter().map(|&e| display::to_infix(&g, e, &name)).collect::<Vec<_>>()
+        d.iter()
+            .map(|&e| display::to_infix(&g, e, &name))
+            .collect::<Vec<_>>()
     };
     assert_eq!(build(), build());
 }
