@@ -1,1 +1,4 @@
 //! Integration, accuracy and snapshot tests of pfaff.
+
+#[cfg(test)]
+mod accuracy;
