@@ -1,5 +1,75 @@
-//! The generator behind `#[pfaff::mechanism]`.
-pub fn expand(args: proc_macro2::TokenStream, input: proc_macro2::TokenStream) -> proc_macro2::TokenStream {
-    let _ = args;
-    input
+//! The generator behind `#[pfaff::mechanism]`: a pipeline of stages on `proc_macro2`.
+//!
+//! ```text
+//! parse::parse          syn tokens → surface description (every span kept)
+//! model::lower          → model::Model (names resolved, items grouped by role)
+//! derive::derive        expressions → sym::Graph (hash-consed, canonical DAG), then
+//!                       M, Q, C, C_q, C_t, γ_h, G, g, γ_nh with their sparsity
+//! sched::schedule       per generated function → straight-line program
+//! emit::mechanism       → the module implementing `pfaff::Mechanism`
+//! ```
+//! User errors are collected in a [`ctxt::Ctxt`] and reported together with spans; on
+//! error a fallback module keeps the rest of the user's crate compiling.
+//!
+//! [`expand`] is what the proc macro calls; [`analyze`] exposes the intermediate
+//! results to tests, snapshots and benchmarks.
+
+pub mod ctxt;
+pub mod derive;
+pub mod emit;
+pub mod model;
+pub mod parse;
+pub mod sched;
+pub mod sym;
+
+use proc_macro2::TokenStream;
+
+/// The results of the front and middle stages for one model.
+#[derive(Debug)]
+pub struct Analysis {
+    pub model: model::Model,
+    pub graph: sym::Graph,
+    pub derived: derive::Derived,
+}
+
+/// Runs parsing, lowering and derivation. Errors come back as one combined
+/// `syn::Error` carrying every diagnostic.
+pub fn analyze(args: TokenStream, input: TokenStream) -> syn::Result<Analysis> {
+    let cx = ctxt::Ctxt::new();
+    let Some(ast) = parse::parse(&cx, args, input) else {
+        cx.check()?;
+        unreachable!("parse failures are recorded in the context");
+    };
+    let model = model::lower(&cx, ast);
+    let mut graph = sym::Graph::new();
+    let derived = if cx.has_errors() {
+        None
+    } else {
+        derive::derive(&cx, &model, &mut graph)
+    };
+    cx.check()?;
+    let derived = derived.expect("derivation succeeds when no error was recorded");
+    Ok(Analysis {
+        model,
+        graph,
+        derived,
+    })
+}
+
+/// Expands `#[mechanism]` on `input`.
+pub fn expand(args: TokenStream, input: TokenStream) -> TokenStream {
+    // Keep the module's name for the fallback before the input is consumed.
+    let head = syn::parse2::<syn::ItemMod>(input.clone())
+        .ok()
+        .map(|m| (m.vis, m.ident));
+    match analyze(args, input) {
+        Ok(a) => emit::mechanism(&a.model, &a.derived, &a.graph),
+        Err(e) => {
+            let mut out = e.to_compile_error();
+            if let Some((vis, ident)) = head {
+                out.extend(emit::fallback(&vis, &ident));
+            }
+            out
+        }
+    }
 }

@@ -1,0 +1,216 @@
+//! Printing one expression as Rust tokens: one `match` arm per node kind, precedence-
+//! aware, turning `(−1)·x`, `a + (−1)·b` and `a · b⁻¹` back into `-x`, `a - b`, `a / b`.
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::quote;
+
+use crate::sched::Program;
+use crate::sym::{ExprId, Graph, Node};
+
+/// Binding strength of an emitted expression.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Prec {
+    Sum,
+    Product,
+    Unary,
+    Atom,
+}
+
+/// Names of the leaves and temporaries.
+pub trait Names {
+    fn var(&self, v: crate::sym::Var) -> Ident;
+    fn temp(&self, k: usize) -> Ident;
+}
+
+/// Prints expressions of one program.
+#[allow(missing_debug_implementations)] // holds a `dyn Names`
+pub struct Printer<'a> {
+    pub g: &'a Graph,
+    pub prog: &'a Program,
+    pub names: &'a dyn Names,
+}
+
+fn wrap(ts: TokenStream, prec: Prec, need: Prec) -> TokenStream {
+    if prec < need {
+        quote!((#ts))
+    } else {
+        ts
+    }
+}
+
+/// A non-negative finite `f64` literal, or the named constant for other values.
+pub fn literal(v: f64) -> (TokenStream, Prec) {
+    if v.is_nan() {
+        return (quote!(f64::NAN), Prec::Atom);
+    }
+    if v.is_infinite() {
+        return if v > 0.0 {
+            (quote!(f64::INFINITY), Prec::Atom)
+        } else {
+            (quote!(f64::NEG_INFINITY), Prec::Atom)
+        };
+    }
+    let lit = Literal::f64_unsuffixed(v.abs());
+    if v < 0.0 {
+        (quote!(-#lit), Prec::Unary)
+    } else {
+        (quote!(#lit), Prec::Atom)
+    }
+}
+
+impl Printer<'_> {
+    /// Tokens of `id`, using its temporary when it has one (unless `define` is set, to
+    /// print the definition of that temporary itself).
+    pub fn expr(&self, id: ExprId, define: bool) -> (TokenStream, Prec) {
+        if !define {
+            if let Some(k) = self.prog.temp(id) {
+                let name = self.names.temp(k);
+                return (quote!(#name), Prec::Atom);
+            }
+        }
+        match self.g.node(id) {
+            Node::Const(b) => literal(f64::from_bits(*b)),
+            Node::Var(v) => {
+                let name = self.names.var(*v);
+                (quote!(#name), Prec::Atom)
+            }
+            Node::Add(terms) => self.sum(terms),
+            Node::Mul(factors) => {
+                let (neg, ts, prec) = self.product(factors);
+                if neg {
+                    let ts = wrap(ts, prec, Prec::Unary);
+                    (quote!(-#ts), Prec::Unary)
+                } else {
+                    (ts, prec)
+                }
+            }
+            Node::Powi(x, n) if *n < 0 => {
+                let d = self.power(*x, -n);
+                (quote!(1.0 / #d), Prec::Product)
+            }
+            Node::Powi(x, n) => (self.power(*x, *n), Prec::Atom),
+            Node::Powf(x, y) => {
+                let x = self.atom(*x);
+                let (y, _) = self.expr(*y, false);
+                (quote!(#x.powf(#y)), Prec::Atom)
+            }
+            Node::Call(f, x) => {
+                let x = self.atom(*x);
+                let m = Ident::new(f.name(), Span::call_site());
+                (quote!(#x.#m()), Prec::Atom)
+            }
+            Node::Atan2(y, x) => {
+                let y = self.atom(*y);
+                let (x, _) = self.expr(*x, false);
+                (quote!(#y.atan2(#x)), Prec::Atom)
+            }
+        }
+    }
+
+    /// An operand in receiver position (`x` in `x.sin()`).
+    fn atom(&self, id: ExprId) -> TokenStream {
+        let (ts, p) = self.expr(id, false);
+        wrap(ts, p, Prec::Atom)
+    }
+
+    /// `x^n`, `n > 0`.
+    fn power(&self, x: ExprId, n: i32) -> TokenStream {
+        let b = self.atom(x);
+        if n == 1 {
+            b
+        } else {
+            let n = Literal::i32_unsuffixed(n);
+            quote!(#b.powi(#n))
+        }
+    }
+
+    /// The sign of a term and its magnitude's tokens.
+    fn signed_term(&self, id: ExprId) -> (bool, TokenStream, Prec) {
+        if self.prog.temp(id).is_none() {
+            match self.g.node(id) {
+                Node::Const(b) if f64::from_bits(*b) < 0.0 => {
+                    let (ts, p) = literal(-f64::from_bits(*b));
+                    return (true, ts, p);
+                }
+                Node::Mul(f) => return self.product(f),
+                _ => {}
+            }
+        }
+        let (ts, p) = self.expr(id, false);
+        (false, ts, p)
+    }
+
+    fn sum(&self, terms: &[ExprId]) -> (TokenStream, Prec) {
+        let mut parts: Vec<(bool, TokenStream, Prec)> = terms.iter().map(|&t| self.signed_term(t)).collect();
+        // Positive terms first reads better: `a - b` rather than `-b + a`.
+        parts.sort_by_key(|p| p.0);
+        let mut out = TokenStream::new();
+        for (i, (neg, ts, prec)) in parts.into_iter().enumerate() {
+            let ts = wrap(ts, prec, Prec::Product);
+            match (i, neg) {
+                (0, false) => out.extend(ts),
+                (0, true) => out.extend(quote!(-#ts)),
+                (_, false) => out.extend(quote!(+ #ts)),
+                (_, true) => out.extend(quote!(- #ts)),
+            }
+        }
+        (out, Prec::Sum)
+    }
+
+    /// A product as `(negative, |product| tokens, precedence)`: the coefficient and the
+    /// positive powers form the numerator, the negative powers the denominator.
+    fn product(&self, factors: &[ExprId]) -> (bool, TokenStream, Prec) {
+        let mut coef = 1.0;
+        let mut num: Vec<(TokenStream, Prec)> = Vec::new();
+        let mut den = Vec::new();
+        for &f in factors {
+            if self.prog.temp(f).is_none() {
+                match self.g.node(f) {
+                    Node::Const(b) => {
+                        coef *= f64::from_bits(*b);
+                        continue;
+                    }
+                    Node::Powi(x, n) if *n < 0 => {
+                        den.push(self.power(*x, -n));
+                        continue;
+                    }
+                    _ => {}
+                }
+            }
+            num.push(self.expr(f, false));
+        }
+        let neg = coef < 0.0;
+        let mag = coef.abs();
+        if mag != 1.0 || num.is_empty() {
+            num.insert(0, literal(mag));
+        }
+        let (mut out, mut prec) = if num.len() == 1 {
+            num.pop().expect("one factor")
+        } else {
+            (join(num.into_iter().map(|(ts, p)| wrap(ts, p, Prec::Unary)), &quote!(*)), Prec::Product)
+        };
+        if !den.is_empty() {
+            out = wrap(out, prec, Prec::Product);
+            let d = if den.len() == 1 {
+                den.pop().expect("one factor")
+            } else {
+                let d = join(den.into_iter(), &quote!(*));
+                quote!((#d))
+            };
+            out.extend(quote!(/ #d));
+            prec = Prec::Product;
+        }
+        (neg, out, prec)
+    }
+}
+
+fn join(parts: impl Iterator<Item = TokenStream>, sep: &TokenStream) -> TokenStream {
+    let mut out = TokenStream::new();
+    for (i, ts) in parts.enumerate() {
+        if i > 0 {
+            out.extend(sep.clone());
+        }
+        out.extend(ts);
+    }
+    out
+}

@@ -1,0 +1,406 @@
+//! Emission: derived quantities → the Rust module that implements `pfaff::Mechanism`.
+//!
+//! Input: the [`Model`] (names, docs, visibility) and the [`Derived`] expressions.
+//! Output: tokens of the replacement module with `Params`, `Model`, `INFO` and the trait
+//! impl. A function whose outputs are all identically zero for the model is not emitted
+//! (the trait's default fills zeros). Runtime paths go through `::pfaff::__private`.
+
+pub mod expr;
+
+use std::collections::HashSet;
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::derive::{Derived, Entry};
+use crate::model::Model;
+use crate::sched::{self, Program};
+use crate::sym::{ExprId, Graph, Var};
+use expr::{Names, Printer};
+
+/// Names of leaves and temporaries in generated code.
+struct ModelNames {
+    coords: Vec<Ident>,
+    velocities: Vec<Ident>,
+    params: Vec<Ident>,
+    temp_prefix: &'static str,
+}
+
+impl ModelNames {
+    fn new(model: &Model) -> ModelNames {
+        let declared: HashSet<String> = model
+            .coords
+            .iter()
+            .map(|c| c.name.to_string())
+            .chain(model.params.iter().map(|p| p.name.to_string()))
+            .collect();
+        let velocities = model
+            .coords
+            .iter()
+            .map(|c| {
+                let mut name = format!("{}_dot", c.name);
+                while declared.contains(&name) {
+                    name.push('_');
+                }
+                Ident::new(&name, Span::call_site())
+            })
+            .collect();
+        let clash = declared
+            .iter()
+            .any(|n| n.len() > 1 && n.starts_with('t') && n[1..].bytes().all(|b| b.is_ascii_digit()));
+        ModelNames {
+            coords: model.coords.iter().map(|c| c.name.clone()).collect(),
+            velocities,
+            params: model.params.iter().map(|p| p.name.clone()).collect(),
+            temp_prefix: if clash { "tmp_" } else { "t" },
+        }
+    }
+}
+
+impl Names for ModelNames {
+    fn var(&self, v: Var) -> Ident {
+        match v {
+            Var::Time => Ident::new("t", Span::call_site()),
+            Var::Q(i) => self.coords[i as usize].clone(),
+            Var::Qd(i) => self.velocities[i as usize].clone(),
+            Var::Param(i) => self.params[i as usize].clone(),
+            Var::Delta(i) => format_ident!("delta_{}", self.coords[i as usize]),
+        }
+    }
+    fn temp(&self, k: usize) -> Ident {
+        format_ident!("{}{}", self.temp_prefix, k)
+    }
+}
+
+/// The body of a generated function: reads of the variables it uses, its temporaries,
+/// and a final statement per output produced by `store`.
+fn body(
+    g: &Graph,
+    names: &ModelNames,
+    roots: &[ExprId],
+    store: impl Fn(usize, TokenStream) -> TokenStream,
+) -> (TokenStream, Program) {
+    let prog = sched::schedule(g, roots);
+    let printer = Printer {
+        g,
+        prog: &prog,
+        names,
+    };
+    let mut out = TokenStream::new();
+    for v in &prog.vars {
+        let name = names.var(*v);
+        out.extend(match v {
+            Var::Time => quote!(),
+            Var::Q(i) => {
+                let i = Literal::u32_unsuffixed(*i);
+                quote!(let #name = q[#i];)
+            }
+            Var::Qd(i) => {
+                let i = Literal::u32_unsuffixed(*i);
+                quote!(let #name = qd[#i];)
+            }
+            Var::Param(_) => quote!(let #name = self.params.#name;),
+            Var::Delta(_) => unreachable!("variations never reach generated code"),
+        });
+    }
+    for (k, &id) in prog.lets.iter().enumerate() {
+        let name = names.temp(k);
+        let (ts, _) = printer.expr(id, true);
+        out.extend(quote!(let #name = #ts;));
+    }
+    for (k, &r) in roots.iter().enumerate() {
+        let (ts, _) = printer.expr(r, false);
+        out.extend(store(k, ts));
+    }
+    (out, prog)
+}
+
+/// The argument name for `t`, `q` or `qd`: prefixed with `_` when unused.
+fn arg(prog: &Program, name: &str, used: impl Fn(&Var) -> bool) -> Ident {
+    if prog.vars.iter().any(used) {
+        Ident::new(name, Span::call_site())
+    } else {
+        format_ident!("_{}", name)
+    }
+}
+
+/// A trait method writing a vector of outputs into `out`, with or without `qd`.
+fn vector_fn(
+    g: &Graph,
+    names: &ModelNames,
+    fn_name: &str,
+    roots: &[ExprId],
+    with_qd: bool,
+) -> TokenStream {
+    let (code, prog) = body(g, names, roots, |k, ts| {
+        let k = Literal::usize_unsuffixed(k);
+        quote!(out[#k] = #ts;)
+    });
+    let name = Ident::new(fn_name, Span::call_site());
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    if with_qd {
+        let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
+        quote! {
+            fn #name(&self, #t: f64, #q: &[f64], #qd: &[f64], out: &mut [f64]) { #code }
+        }
+    } else {
+        quote! {
+            fn #name(&self, #t: f64, #q: &[f64], out: &mut [f64]) { #code }
+        }
+    }
+}
+
+fn entries(e: &[Entry]) -> Vec<ExprId> {
+    e.iter().map(|e| e.expr).collect()
+}
+
+fn pattern(e: &[Entry]) -> TokenStream {
+    let items = e.iter().map(|e| {
+        let (r, c) = (Literal::u32_unsuffixed(e.row), Literal::u32_unsuffixed(e.col));
+        quote!((#r, #c))
+    });
+    quote!(&[#(#items),*])
+}
+
+fn any_nonzero(g: &Graph, ids: &[ExprId]) -> bool {
+    ids.iter().any(|&e| !g.is_zero(e))
+}
+
+/// `#[doc]` attributes for a doc text, one per line with the leading space that `///`
+/// comments have, so formatted output reads `/// text`.
+fn doc_attr(docs: &str) -> TokenStream {
+    let lines = docs.lines().map(|l| format!(" {l}"));
+    quote!(#(#[doc = #lines])*)
+}
+
+/// The replacement module for a successfully derived model.
+pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
+    let names = ModelNames::new(model);
+    let vis = &model.vis;
+    let ident = &model.ident;
+    let attrs = &model.attrs;
+    let docs = &model.docs;
+    let name_str = ident.to_string();
+
+    let pnames = &names.params;
+    let pdocs: Vec<TokenStream> = model.params.iter().map(|p| doc_attr(&p.docs)).collect();
+    let pdefaults: Vec<TokenStream> = d.param_defaults.iter().map(|&v| expr::literal(v).0).collect();
+    let param_count = model.params.len();
+    let param_idx: Vec<Literal> = (0..param_count).map(Literal::usize_unsuffixed).collect();
+
+    let symbols = |items: &mut dyn Iterator<Item = (String, &String)>| {
+        let items: Vec<TokenStream> = items
+            .map(|(n, doc)| quote!(::pfaff::__private::Symbol { name: #n, doc: #doc }))
+            .collect();
+        quote!(&[#(#items),*])
+    };
+    let coordinates = symbols(&mut model.coords.iter().map(|c| (c.name.to_string(), &c.docs)));
+    let holonomic = symbols(&mut model.holonomic.iter().map(|c| (c.name.to_string(), &c.docs)));
+    let nonholonomic = symbols(&mut model.nonholonomic.iter().map(|c| (c.name.to_string(), &c.docs)));
+    let parameters: Vec<TokenStream> = model
+        .params
+        .iter()
+        .zip(&pdefaults)
+        .map(|(p, v)| {
+            let (n, doc) = (p.name.to_string(), &p.docs);
+            quote!(::pfaff::__private::Parameter { name: #n, doc: #doc, default: #v })
+        })
+        .collect();
+    let mass_pattern = pattern(&d.mass);
+    let cq_pattern = pattern(&d.cq);
+    let g_pattern = pattern(&d.gm);
+    let (tm, tf, th, tn) = (d.time.mass, d.time.forces, d.time.holonomic, d.time.nonholonomic);
+    let homogeneous = d.homogeneous;
+    let conservative = d.conservative;
+
+    let mut fns = TokenStream::new();
+    if let Some((q0, qd0)) = &d.initial {
+        let mut roots = q0.clone();
+        roots.extend(qd0);
+        let n = q0.len();
+        let (code, _) = body(g, &names, &roots, |k, ts| {
+            if k < n {
+                let k = Literal::usize_unsuffixed(k);
+                quote!(q[#k] = #ts;)
+            } else {
+                let k = Literal::usize_unsuffixed(k - n);
+                quote!(qd[#k] = #ts;)
+            }
+        });
+        fns.extend(quote! {
+            fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) { #code }
+        });
+    }
+    fns.extend(vector_fn(g, &names, "mass_matrix", &entries(&d.mass), false));
+    fns.extend(vector_fn(g, &names, "forces", &d.forces, true));
+    if !d.c.is_empty() {
+        fns.extend(vector_fn(g, &names, "holonomic", &d.c, false));
+        fns.extend(vector_fn(g, &names, "holonomic_jacobian", &entries(&d.cq), false));
+        if any_nonzero(g, &d.ct) {
+            fns.extend(vector_fn(g, &names, "holonomic_rate", &d.ct, false));
+        }
+        if any_nonzero(g, &d.gamma_h) {
+            fns.extend(vector_fn(g, &names, "holonomic_gamma", &d.gamma_h, true));
+        }
+    }
+    if !d.gb.is_empty() {
+        fns.extend(vector_fn(g, &names, "nonholonomic_matrix", &entries(&d.gm), false));
+        if any_nonzero(g, &d.gb) {
+            fns.extend(vector_fn(g, &names, "nonholonomic_bias", &d.gb, false));
+        }
+        if any_nonzero(g, &d.gamma_nh) {
+            fns.extend(vector_fn(g, &names, "nonholonomic_gamma", &d.gamma_nh, true));
+        }
+    }
+    {
+        let (code, prog) = body(g, &names, &[d.kinetic], |_, ts| ts);
+        let t = arg(&prog, "t", |v| *v == Var::Time);
+        let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+        let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
+        fns.extend(quote! {
+            fn kinetic_energy(&self, #t: f64, #q: &[f64], #qd: &[f64]) -> f64 { #code }
+        });
+    }
+    if !g.is_zero(d.potential) {
+        let (code, prog) = body(g, &names, &[d.potential], |_, ts| ts);
+        let t = arg(&prog, "t", |v| *v == Var::Time);
+        let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+        fns.extend(quote! {
+            fn potential_energy(&self, #t: f64, #q: &[f64]) -> f64 { #code }
+        });
+    }
+
+    let model_doc = format!(" The `{name_str}` mechanism with its parameters.");
+    let params_doc = format!(" Parameters of `{name_str}`, with the defaults declared in the model.");
+    let info_doc = format!(" Names, sizes, sparsity patterns and structural flags of `{name_str}`.");
+    let get = if param_count == 0 {
+        quote!(::core::panic!("`{}` has no parameters (index {})", #name_str, index))
+    } else {
+        quote! {
+            match index {
+                #(#param_idx => self.params.#pnames,)*
+                _ => ::core::panic!("parameter index {} out of range for `{}`", index, #name_str),
+            }
+        }
+    };
+    let set = if param_count == 0 {
+        quote!(::core::panic!("`{}` has no parameters (index {}, value {})", #name_str, index, value))
+    } else {
+        quote! {
+            match index {
+                #(#param_idx => self.params.#pnames = value,)*
+                _ => ::core::panic!("parameter index {} out of range for `{}`", index, #name_str),
+            }
+        }
+    };
+
+    let mod_doc = doc_attr(docs);
+    quote! {
+        #(#attrs)*
+        #mod_doc
+        #vis mod #ident {
+            #[doc = #params_doc]
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct Params {
+                #(#pdocs pub #pnames: f64,)*
+            }
+
+            impl ::core::default::Default for Params {
+                fn default() -> Self {
+                    Self { #(#pnames: #pdefaults,)* }
+                }
+            }
+
+            #[doc = #model_doc]
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Model {
+                /// The parameter values.
+                pub params: Params,
+            }
+
+            impl Model {
+                /// The mechanism with the given parameters.
+                #[must_use]
+                pub const fn new(params: Params) -> Self {
+                    Self { params }
+                }
+            }
+
+            #[doc = #info_doc]
+            pub static INFO: ::pfaff::__private::Info = ::pfaff::__private::Info {
+                name: #name_str,
+                doc: #docs,
+                coordinates: #coordinates,
+                parameters: &[#(#parameters),*],
+                holonomic: #holonomic,
+                nonholonomic: #nonholonomic,
+                mass_pattern: #mass_pattern,
+                holonomic_pattern: #cq_pattern,
+                nonholonomic_pattern: #g_pattern,
+                time: ::pfaff::__private::TimeDependence {
+                    mass: #tm,
+                    forces: #tf,
+                    holonomic: #th,
+                    nonholonomic: #tn,
+                },
+                nonholonomic_homogeneous: #homogeneous,
+                conservative: #conservative,
+            };
+
+            #[allow(non_snake_case, clippy::all, clippy::pedantic)]
+            impl ::pfaff::__private::Mechanism for Model {
+                fn info(&self) -> &'static ::pfaff::__private::Info {
+                    &INFO
+                }
+                fn parameter(&self, index: usize) -> f64 {
+                    #get
+                }
+                fn set_parameter(&mut self, index: usize, value: f64) {
+                    #set
+                }
+                #fns
+            }
+        }
+    }
+}
+
+/// The module emitted after user errors: the same public items with bodies that are
+/// never run, so that uses of the model elsewhere do not add errors of their own.
+pub fn fallback(vis: &syn::Visibility, ident: &Ident) -> TokenStream {
+    quote! {
+        #vis mod #ident {
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Params {}
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Model {
+                pub params: Params,
+            }
+            impl Model {
+                pub const fn new(params: Params) -> Self {
+                    Self { params }
+                }
+            }
+            impl ::pfaff::__private::Mechanism for Model {
+                fn info(&self) -> &'static ::pfaff::__private::Info {
+                    ::core::unreachable!()
+                }
+                fn parameter(&self, _: usize) -> f64 {
+                    ::core::unreachable!()
+                }
+                fn set_parameter(&mut self, _: usize, _: f64) {
+                    ::core::unreachable!()
+                }
+                fn mass_matrix(&self, _: f64, _: &[f64], _: &mut [f64]) {
+                    ::core::unreachable!()
+                }
+                fn forces(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {
+                    ::core::unreachable!()
+                }
+                fn kinetic_energy(&self, _: f64, _: &[f64], _: &[f64]) -> f64 {
+                    ::core::unreachable!()
+                }
+            }
+        }
+    }
+}

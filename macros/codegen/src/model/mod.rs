@@ -1,0 +1,193 @@
+//! Lowering: the surface description → a [`Model`] with resolved names.
+//!
+//! Input: [`parse::Mechanism`]. Output: declarations grouped by role, each coordinate,
+//! parameter and constraint with a stable index. Checks: duplicate and reserved names,
+//! exactly one kinetic-energy description, forces on existing coordinates. Expressions
+//! stay as `syn` trees here; [`expr`] translates them into the symbolic graph.
+
+pub mod expr;
+
+use std::collections::HashMap;
+
+use crate::ctxt::{suggest, Ctxt};
+use crate::parse::{self, kw, FnItem, Role};
+
+/// A parameter declaration.
+#[derive(Debug)]
+pub struct Param {
+    pub name: syn::Ident,
+    pub docs: String,
+    pub default: syn::Expr,
+}
+
+/// A coordinate declaration.
+#[derive(Debug)]
+pub struct Coord {
+    pub name: syn::Ident,
+    pub docs: String,
+    pub q0: Option<syn::Expr>,
+    pub qd0: Option<syn::Expr>,
+}
+
+/// The lowered model.
+#[derive(Debug)]
+pub struct Model {
+    pub vis: syn::Visibility,
+    pub ident: syn::Ident,
+    pub docs: String,
+    pub attrs: Vec<syn::Attribute>,
+    pub params: Vec<Param>,
+    pub coords: Vec<Coord>,
+    pub kinetic: Option<FnItem>,
+    pub mass_matrix: Option<FnItem>,
+    pub potential: Option<FnItem>,
+    /// `#[force(c)]` items with the index of `c`.
+    pub forces: Vec<(u32, FnItem)>,
+    pub virtual_work: Vec<FnItem>,
+    pub holonomic: Vec<FnItem>,
+    pub nonholonomic: Vec<FnItem>,
+    /// Intermediate definitions, in declaration order.
+    pub definitions: Vec<FnItem>,
+}
+
+impl Model {
+    /// Number of coordinates.
+    pub fn nq(&self) -> usize {
+        self.coords.len()
+    }
+    /// Index of the coordinate called `name`.
+    pub fn coord_index(&self, name: &str) -> Option<u32> {
+        self.coords
+            .iter()
+            .position(|c| c.name == name)
+            .map(|i| u32::try_from(i).expect("coordinate count fits u32"))
+    }
+    /// Index of the parameter called `name`.
+    pub fn param_index(&self, name: &str) -> Option<u32> {
+        self.params
+            .iter()
+            .position(|c| c.name == name)
+            .map(|i| u32::try_from(i).expect("parameter count fits u32"))
+    }
+}
+
+/// Groups the items by role and checks names.
+pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
+    let mut model = Model {
+        vis: ast.vis,
+        ident: ast.ident,
+        docs: ast.docs,
+        attrs: ast.attrs,
+        params: Vec::new(),
+        coords: Vec::new(),
+        kinetic: None,
+        mass_matrix: None,
+        potential: None,
+        forces: Vec::new(),
+        virtual_work: Vec::new(),
+        holonomic: Vec::new(),
+        nonholonomic: Vec::new(),
+        definitions: Vec::new(),
+    };
+    let mut seen: HashMap<String, syn::Ident> = HashMap::new();
+    let mut declare = |name: &syn::Ident| {
+        let s = name.to_string();
+        if kw::RESERVED.contains(&s.as_str()) {
+            cx.error_spanned_by(name, format!("`{s}` is reserved and cannot be declared"));
+        } else if seen.contains_key(&s) {
+            cx.error_spanned_by(name, format!("duplicate name `{s}`: it is declared above"));
+        } else {
+            seen.insert(s, name.clone());
+        }
+    };
+    let mut pending_forces = Vec::new();
+    for item in ast.items {
+        match item {
+            parse::Item::Param {
+                name,
+                docs,
+                default,
+            } => {
+                declare(&name);
+                model.params.push(Param {
+                    name,
+                    docs,
+                    default,
+                });
+            }
+            parse::Item::Coord { name, docs, q0, qd0 } => {
+                declare(&name);
+                model.coords.push(Coord { name, docs, q0, qd0 });
+            }
+            parse::Item::Fn(f) => {
+                if f.name == kw::DELTA {
+                    cx.error_spanned_by(&f.name, "`delta` is reserved for variations and cannot name a function");
+                }
+                declare(&f.name);
+                let slot = match &f.role {
+                    Role::KineticEnergy => &mut model.kinetic,
+                    Role::PotentialEnergy => &mut model.potential,
+                    Role::MassMatrix => &mut model.mass_matrix,
+                    Role::Holonomic => {
+                        model.holonomic.push(f);
+                        continue;
+                    }
+                    Role::Nonholonomic => {
+                        model.nonholonomic.push(f);
+                        continue;
+                    }
+                    Role::VirtualWork => {
+                        model.virtual_work.push(f);
+                        continue;
+                    }
+                    Role::Definition => {
+                        model.definitions.push(f);
+                        continue;
+                    }
+                    Role::Force(_) => {
+                        pending_forces.push(f);
+                        continue;
+                    }
+                };
+                *slot = Some(f);
+            }
+        }
+    }
+    for f in pending_forces {
+        let Role::Force(target) = &f.role else {
+            unreachable!("only forces are pending")
+        };
+        match model.coord_index(&target.to_string()) {
+            Some(i) => model.forces.push((i, f)),
+            None => {
+                let names = model.coords.iter().map(|c| c.name.to_string()).collect::<Vec<_>>();
+                let hint = suggest(&target.to_string(), names.iter().map(String::as_str))
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_default();
+                cx.error_spanned_by(
+                    target,
+                    format!("`#[force({target})]` names no coordinate{hint}"),
+                );
+            }
+        }
+    }
+    if model.coords.is_empty() {
+        cx.error_spanned_by(
+            &model.ident,
+            "a mechanism declares at least one coordinate: `static x: Coordinate = Coordinate {};`",
+        );
+    }
+    match (&model.kinetic, &model.mass_matrix) {
+        (None, None) => cx.error_spanned_by(
+            &model.ident,
+            "a mechanism needs its kinetic energy: `fn kinetic_energy() -> f64 { .. }` or \
+             `fn mass_matrix() -> [[f64; N]; N] { .. }`",
+        ),
+        (Some(_), Some(m)) => cx.error_spanned_by(
+            &m.name,
+            "give either `kinetic_energy` or `mass_matrix`, not both",
+        ),
+        _ => {}
+    }
+    model
+}
