@@ -233,12 +233,18 @@ pub mod andrews {
     /// Loop through A via bodies 6 and 7, x.
     #[holonomic]
     fn loop_a7_x() -> f64 {
-        rr * beta.cos() - d * (beta + theta).cos() - zf * (omega + epsilon).cos() - u * epsilon.sin() - xa
+        rr * beta.cos()
+            - d * (beta + theta).cos()
+            - zf * (omega + epsilon).cos()
+            - u * epsilon.sin()
+            - xa
     }
 
     /// Loop through A via bodies 6 and 7, y.
     #[holonomic]
     fn loop_a7_y() -> f64 {
-        rr * beta.sin() - d * (beta + theta).sin() - zf * (omega + epsilon).sin() + u * epsilon.cos() - ya
+        rr * beta.sin() - d * (beta + theta).sin() - zf * (omega + epsilon).sin()
+            + u * epsilon.cos()
+            - ya
     }
 }

@@ -55,8 +55,8 @@ macro_rules! reference_parameters {
 }
 
 reference_parameters!(
-    m1, m2, m3, m4, m5, m6, m7, i1, i2, i3, i4, i5, i6, i7, xa, ya, xb, yb, xc, yc, c0, d, da,
-    e, ea, rr, ra, l0, ss, sa, sb, sc, sd, ta, tb, u, ua, ub, zf, zt, fa, mom,
+    m1, m2, m3, m4, m5, m6, m7, i1, i2, i3, i4, i5, i6, i7, xa, ya, xb, yb, xc, yc, c0, d, da, e,
+    ea, rr, ra, l0, ss, sa, sb, sc, sd, ta, tb, u, ua, ub, zf, zt, fa, mom,
 );
 
 impl Hw {
@@ -64,8 +64,36 @@ impl Hw {
     #[allow(clippy::similar_names)]
     fn mass(&self, q: &[f64]) -> [[f64; 7]; 7] {
         let Hw {
-            m1, m2, m3, m4, m5, m6, m7, i1, i2, i3, i4, i5, i6, i7, da, e, ea, rr, ra, sa, sb,
-            ta, tb, u, ua, ub, zf, zt, fa, ..
+            m1,
+            m2,
+            m3,
+            m4,
+            m5,
+            m6,
+            m7,
+            i1,
+            i2,
+            i3,
+            i4,
+            i5,
+            i6,
+            i7,
+            da,
+            e,
+            ea,
+            rr,
+            ra,
+            sa,
+            sb,
+            ta,
+            tb,
+            u,
+            ua,
+            ub,
+            zf,
+            zt,
+            fa,
+            ..
         } = *self;
         let (cth, sph, som) = (q[1].cos(), q[3].sin(), q[5].sin());
         let mut m = [[0.0; 7]; 7];
@@ -104,10 +132,29 @@ impl Hw {
     /// the comparison is relative.
     fn forces(&self, q: &[f64], v: &[f64]) -> ([f64; 7], [f64; 7]) {
         let Hw {
-            m2, m4, m6, c0, da, e, ea, rr, l0, sc, sd, u, zf, zt, fa, xc, yc, mom, ..
+            m2,
+            m4,
+            m6,
+            c0,
+            da,
+            e,
+            ea,
+            rr,
+            l0,
+            sc,
+            sd,
+            u,
+            zf,
+            zt,
+            fa,
+            xc,
+            yc,
+            mom,
+            ..
         } = *self;
         let (bep, thp, php, dep, omp, epp) = (v[0], v[1], v[3], v[4], v[5], v[6]);
-        let (sith, coga, siga, coph, coom) = (q[1].sin(), q[2].cos(), q[2].sin(), q[3].cos(), q[5].cos());
+        let (sith, coga, siga, coph, coom) =
+            (q[1].sin(), q[2].cos(), q[2].sin(), q[3].cos(), q[5].cos());
         let (xd, yd, len) = self.spring(q[2]);
         let force = -c0 * (len - l0) / len;
         let (fx, fy) = (force * (xd - xc), force * (yd - yc));
@@ -139,7 +186,18 @@ impl Hw {
     /// The six loop-closure constraints of benchmark-models.md.
     fn constraints(&self, q: &[f64]) -> [f64; 6] {
         let Hw {
-            xa, ya, xb, yb, d, e, rr, ss, u, zf, zt, ..
+            xa,
+            ya,
+            xb,
+            yb,
+            d,
+            e,
+            rr,
+            ss,
+            u,
+            zf,
+            zt,
+            ..
         } = *self;
         let (be, th, ga, ph, de, om, ep) = (q[0], q[1], q[2], q[3], q[4], q[5], q[6]);
         let x = rr * be.cos() - d * (be + th).cos();
@@ -188,21 +246,62 @@ fn sample(rng: &mut Rng) -> State {
 #[test]
 fn info() {
     check_parameters!(
-        m1 = 0.04325, m2 = 0.00365, m3 = 0.02373, m4 = 0.00706, m5 = 0.07050, m6 = 0.00706,
-        m7 = 0.05498, i1 = 2.194e-6, i2 = 4.410e-7, i3 = 5.255e-6, i4 = 5.667e-7,
-        i5 = 1.169e-5, i6 = 5.667e-7, i7 = 1.912e-5, xa = -0.06934, ya = -0.00227,
-        xb = -0.03635, yb = 0.03273, xc = 0.014, yc = 0.072, c0 = 4530.0, d = 28e-3,
-        da = 115e-4, e = 2e-2, ea = 1421e-5, rr = 7e-3, ra = 92e-5, l0 = 7785e-5,
-        ss = 35e-3, sa = 1874e-5, sb = 1043e-5, sc = 18e-3, sd = 2e-2, ta = 2308e-5,
-        tb = 916e-5, u = 4e-2, ua = 1228e-5, ub = 449e-5, zf = 2e-2, zt = 4e-2,
-        fa = 1421e-5, mom = 33e-3,
+        m1 = 0.04325,
+        m2 = 0.00365,
+        m3 = 0.02373,
+        m4 = 0.00706,
+        m5 = 0.07050,
+        m6 = 0.00706,
+        m7 = 0.05498,
+        i1 = 2.194e-6,
+        i2 = 4.410e-7,
+        i3 = 5.255e-6,
+        i4 = 5.667e-7,
+        i5 = 1.169e-5,
+        i6 = 5.667e-7,
+        i7 = 1.912e-5,
+        xa = -0.06934,
+        ya = -0.00227,
+        xb = -0.03635,
+        yb = 0.03273,
+        xc = 0.014,
+        yc = 0.072,
+        c0 = 4530.0,
+        d = 28e-3,
+        da = 115e-4,
+        e = 2e-2,
+        ea = 1421e-5,
+        rr = 7e-3,
+        ra = 92e-5,
+        l0 = 7785e-5,
+        ss = 35e-3,
+        sa = 1874e-5,
+        sb = 1043e-5,
+        sc = 18e-3,
+        sd = 2e-2,
+        ta = 2308e-5,
+        tb = 916e-5,
+        u = 4e-2,
+        ua = 1228e-5,
+        ub = 449e-5,
+        zf = 2e-2,
+        zt = 4e-2,
+        fa = 1421e-5,
+        mom = 33e-3,
     );
     check_info(
         &Model::default(),
         &Expected {
             name: "andrews",
             coordinates: &["beta", "theta", "gamma", "phi", "delta", "omega", "epsilon"],
-            holonomic: &["loop_b_x", "loop_b_y", "loop_a5_x", "loop_a5_y", "loop_a7_x", "loop_a7_y"],
+            holonomic: &[
+                "loop_b_x",
+                "loop_b_y",
+                "loop_a5_x",
+                "loop_a5_y",
+                "loop_a7_x",
+                "loop_a7_y",
+            ],
             nonholonomic: &[],
             time: TimeDependence::default(),
             homogeneous: true,
@@ -213,15 +312,32 @@ fn info() {
     );
     // The non-zero entries of M listed in benchmark-models.md, both triangles.
     let mass: &[(u32, u32)] = &[
-        (0, 0), (0, 1), (1, 0), (1, 1), (2, 2), (3, 3), (3, 4), (4, 3), (4, 4),
-        (5, 5), (5, 6), (6, 5), (6, 6),
+        (0, 0),
+        (0, 1),
+        (1, 0),
+        (1, 1),
+        (2, 2),
+        (3, 3),
+        (3, 4),
+        (4, 3),
+        (4, 4),
+        (5, 5),
+        (5, 6),
+        (6, 5),
+        (6, 6),
     ];
     assert_eq!(INFO.mass_pattern, mass);
 }
 
 #[test]
 fn derivatives() {
-    sweep("andrews", 0x5eed_0009, Model::default, |m| reference(&m.params), sample);
+    sweep(
+        "andrews",
+        0x5eed_0009,
+        Model::default,
+        |m| reference(&m.params),
+        sample,
+    );
 }
 
 /// The Coriolis terms are small beside the spring (1e-6 against 1): switch the spring
@@ -234,7 +350,13 @@ fn derivatives_without_spring_and_motor() {
         model.params.mom = 0.0;
         model
     };
-    sweep("andrews (c0 = mom = 0)", 0x5eed_000a, make, |m| reference(&m.params), sample);
+    sweep(
+        "andrews (c0 = mom = 0)",
+        0x5eed_000a,
+        make,
+        |m| reference(&m.params),
+        sample,
+    );
 }
 
 /// The generated M and Q against Hairer & Wanner's M and f, directly, at random states
@@ -265,7 +387,12 @@ fn matches_hairer_wanner() {
                 let scale = (M_ref[i][i] * M_ref[j][j]).abs().sqrt();
                 let err = (M[i * 7 + j] - M_ref[i][j]).abs() / scale;
                 worst_m = worst_m.max(err);
-                assert!(err <= TOL, "M[{i}][{j}] = {} vs {} at q = {q:?}", M[i * 7 + j], M_ref[i][j]);
+                assert!(
+                    err <= TOL,
+                    "M[{i}][{j}] = {} vs {} at q = {q:?}",
+                    M[i * 7 + j],
+                    M_ref[i][j]
+                );
             }
         }
         let mut Q = [f64::NAN; 7];
@@ -274,7 +401,12 @@ fn matches_hairer_wanner() {
         for i in 0..7 {
             let err = (Q[i] - f[i]).abs() / scale[i].max(f64::MIN_POSITIVE);
             worst_f = worst_f.max(err);
-            assert!(err <= TOL, "Q[{i}] = {:e} vs f = {:e} at q = {q:?}, q̇ = {v:?}", Q[i], f[i]);
+            assert!(
+                err <= TOL,
+                "Q[{i}] = {:e} vs f = {:e} at q = {q:?}, q̇ = {v:?}",
+                Q[i],
+                f[i]
+            );
         }
     }
     println!("andrews vs Hairer & Wanner: M {worst_m:.1e}, f {worst_f:.1e} (tol {TOL:.0e})");
@@ -290,7 +422,11 @@ fn initial_state_is_consistent() {
     let mut c = [f64::NAN; 6];
     model.holonomic(0.0, &q, &mut c);
     let c_ref = Hw::new(&model.params).constraints(&q);
-    println!("andrews: |C(q0)| = {:.1e} (reference closure {:.1e})", max_abs(&c), max_abs(&c_ref));
+    println!(
+        "andrews: |C(q0)| = {:.1e} (reference closure {:.1e})",
+        max_abs(&c),
+        max_abs(&c_ref)
+    );
     assert!(max_abs(&c) < 1e-15, "C(q0) = {c:?}");
     assert!(max_abs(&c_ref) < 1e-15, "C_ref(q0) = {c_ref:?}");
     assert_eq!(qd, [0.0; 7]);

@@ -14,19 +14,29 @@ fn reference(p: &Params) -> Reference {
     let k = mass * eps.powi(2) / 2.0;
     let yb = move |t: f64| r * (w * t).sin();
     let xb = move |t: f64| (l.powi(2) - yb(t).powi(2)).sqrt();
-    Reference::new(4, move |_, _, v| 0.5 * k * v.iter().map(|v| v * v).sum::<f64>())
-        .potential(move |t, q| {
-            let left = (q[0].powi(2) + q[1].powi(2)).sqrt();
-            let right = ((q[2] - xb(t)).powi(2) + (q[3] - yb(t)).powi(2)).sqrt();
-            0.5 * (left - l0).powi(2) + 0.5 * (right - l0).powi(2) + k * g * (q[1] + q[3])
-        })
-        .holonomic(move |t, q| xb(t) * q[0] + yb(t) * q[1])
-        .holonomic(move |_, q| (q[0] - q[2]).powi(2) + (q[1] - q[3]).powi(2) - l.powi(2))
+    Reference::new(4, move |_, _, v| {
+        0.5 * k * v.iter().map(|v| v * v).sum::<f64>()
+    })
+    .potential(move |t, q| {
+        let left = (q[0].powi(2) + q[1].powi(2)).sqrt();
+        let right = ((q[2] - xb(t)).powi(2) + (q[3] - yb(t)).powi(2)).sqrt();
+        0.5 * (left - l0).powi(2) + 0.5 * (right - l0).powi(2) + k * g * (q[1] + q[3])
+    })
+    .holonomic(move |t, q| xb(t) * q[0] + yb(t) * q[1])
+    .holonomic(move |_, q| (q[0] - q[2]).powi(2) + (q[1] - q[3]).powi(2) - l.powi(2))
 }
 
 #[test]
 fn info() {
-    check_parameters!(eps = 1e-2, mass = 10.0, l = 1.0, l0 = 0.5, r = 0.1, w = 10.0, g = 1.0);
+    check_parameters!(
+        eps = 1e-2,
+        mass = 10.0,
+        l = 1.0,
+        l0 = 0.5,
+        r = 0.1,
+        w = 10.0,
+        g = 1.0
+    );
     check_info(
         &Model::default(),
         &Expected {
@@ -80,5 +90,8 @@ fn initial_state_is_consistent() {
         .collect();
     assert!(c.iter().all(|c| c.abs() < 1e-15), "C = {c:?}");
     // First differences: tolerance TOL_D1-sized.
-    assert!(velocity.iter().all(|v| v.abs() < 1e-9), "C_q q̇ + C_t = {velocity:?}");
+    assert!(
+        velocity.iter().all(|v| v.abs() < 1e-9),
+        "C_q q̇ + C_t = {velocity:?}"
+    );
 }

@@ -50,11 +50,7 @@ impl Reference {
     }
 
     /// A generalized force on coordinate `index` (`#[force(coordinate)]`).
-    pub fn force(
-        mut self,
-        index: usize,
-        f: impl Fn(f64, &[f64], &[f64]) -> f64 + 'static,
-    ) -> Self {
+    pub fn force(mut self, index: usize, f: impl Fn(f64, &[f64], &[f64]) -> f64 + 'static) -> Self {
         self.forces.push((index, Box::new(f)));
         self
     }
@@ -100,11 +96,6 @@ impl Reference {
 
     pub fn potential_energy(&self, t: f64, q: &[f64]) -> f64 {
         self.potential.as_ref().map_or(0.0, |v| v(t, q))
-    }
-
-    /// `∂T/∂q̇` by first differences.
-    pub fn momentum(&self, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
-        gradient(|v| (self.kinetic)(t, q, v), qd)
     }
 
     /// `M = ∂²T/∂q̇²`, dense row-major, by nested first differences.

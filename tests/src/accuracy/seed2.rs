@@ -16,9 +16,11 @@ use super::{sweep, STATES};
 
 /// The expressions of `models/src/seed2_example1.rs`, re-typed (S2-23 and the force of V2).
 fn reference1() -> Reference {
-    Reference::new(3, |_, _, v| 0.5 * (v[0].powi(2) + v[1].powi(2) + v[2].powi(2)))
-        .holonomic(|t, q| t * q[0] + 2.0 * q[1] - 3.0 * q[2])
-        .force(1, |_, _, v| -v[0])
+    Reference::new(3, |_, _, v| {
+        0.5 * (v[0].powi(2) + v[1].powi(2) + v[2].powi(2))
+    })
+    .holonomic(|t, q| t * q[0] + 2.0 * q[1] - 3.0 * q[2])
+    .force(1, |_, _, v| -v[0])
 }
 
 /// The force of V4 that makes example 2 free.
@@ -81,18 +83,35 @@ fn info() {
         nonholonomic: false,
     };
     // V4 initial state.
-    let e2 = expected("seed2_example2", time2, &[1.0, 0.5, -0.5], &[1.0, 0.2, -0.2]);
+    let e2 = expected(
+        "seed2_example2",
+        time2,
+        &[1.0, 0.5, -0.5],
+        &[1.0, 0.2, -0.2],
+    );
     check_info(&ex2::Model::default(), &e2);
 }
 
 #[test]
 fn derivatives_example1() {
-    sweep("seed2_example1", 0x5eed_0005, ex1::Model::default, |_| reference1(), sample);
+    sweep(
+        "seed2_example1",
+        0x5eed_0005,
+        ex1::Model::default,
+        |_| reference1(),
+        sample,
+    );
 }
 
 #[test]
 fn derivatives_example2() {
-    sweep("seed2_example2", 0x5eed_0006, ex2::Model::default, |_| reference2(), sample);
+    sweep(
+        "seed2_example2",
+        0x5eed_0006,
+        ex2::Model::default,
+        |_| reference2(),
+        sample,
+    );
 }
 
 /// The multiplier λ of math-spec (E0) from the generated M, Q, C_q, γ_h, with the
@@ -128,11 +147,19 @@ fn v1_v3_multipliers() {
         s.t = 1.0;
         s.qd[0] = 0.5;
         let (lambda, _) = multiplier(&ex1::Model::default(), &s, -s.qd[0]);
-        assert!((-lambda - (-1.0 / 14.0)).abs() < 1e-9 / 14.0, "V1: λ = {}", -lambda);
+        assert!(
+            (-lambda - (-1.0 / 14.0)).abs() < 1e-9 / 14.0,
+            "V1: λ = {}",
+            -lambda
+        );
         s.q[0] = 1.0;
         let (lambda, _) = multiplier(&ex2::Model::default(), &s, free_force2(s.t, &s.q, &s.qd));
         let expected = -1.660_306_618_962_82;
-        assert!((-lambda - expected).abs() < 1e-9 * expected.abs(), "V3: λ = {}", -lambda);
+        assert!(
+            (-lambda - expected).abs() < 1e-9 * expected.abs(),
+            "V3: λ = {}",
+            -lambda
+        );
     }
 }
 
@@ -145,10 +172,17 @@ fn v2_v4_motion_is_free() {
     let mut worst: f64 = 0.0;
     for _ in 0..STATES {
         let s = sample(&mut rng);
-        for model in [&ex1::Model::default() as &dyn Mechanism, &ex2::Model::default()] {
+        for model in [
+            &ex1::Model::default() as &dyn Mechanism,
+            &ex2::Model::default(),
+        ] {
             let (lambda, scale) = multiplier(model, &s, 0.0);
             worst = worst.max(lambda.abs() / scale);
-            assert!(lambda.abs() <= 1e-13 * scale, "{}: λ = {lambda:e} at {s:?}", model.info().name);
+            assert!(
+                lambda.abs() <= 1e-13 * scale,
+                "{}: λ = {lambda:e} at {s:?}",
+                model.info().name
+            );
         }
     }
     println!("seed2 V2/V4: max |λ| / scale = {worst:.1e}");

@@ -90,8 +90,15 @@ fn info() {
             name: "slider_crank",
             coordinates: &["x1", "y1", "phi1", "x2", "y2", "phi2", "x3", "y3", "phi3"],
             holonomic: &[
-                "pin_o_x", "pin_o_y", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y", "guide_y",
-                "guide_phi", "driver",
+                "pin_o_x",
+                "pin_o_y",
+                "pin_a_x",
+                "pin_a_y",
+                "pin_b_x",
+                "pin_b_y",
+                "guide_y",
+                "guide_phi",
+                "driver",
             ],
             nonholonomic: &[],
             time: TimeDependence {
@@ -182,7 +189,10 @@ fn v10_kinematics() {
         rel(&velocity, &table_qd),
         rel(&acceleration, &table_qdd)
     );
-    assert!(rel(&velocity, &qd) < 1e-14, "q̇ {velocity:?} vs defaults {qd:?}");
+    assert!(
+        rel(&velocity, &qd) < 1e-14,
+        "q̇ {velocity:?} vs defaults {qd:?}"
+    );
     assert!(rel(&velocity, &table_qd) < 1e-9, "q̇ {velocity:?}");
     assert!(rel(&acceleration, &table_qdd) < 1e-9, "q̈ {acceleration:?}");
 }

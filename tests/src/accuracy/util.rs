@@ -101,7 +101,11 @@ pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// Scatters pattern values into a dense row-major `rows × cols` matrix.
 pub fn dense(pattern: &[(u32, u32)], values: &[f64], rows: usize, cols: usize) -> Vec<f64> {
-    assert_eq!(pattern.len(), values.len(), "pattern and values differ in length");
+    assert_eq!(
+        pattern.len(),
+        values.len(),
+        "pattern and values differ in length"
+    );
     let mut out = vec![0.0; rows * cols];
     for (&(r, c), &v) in pattern.iter().zip(values) {
         out[r as usize * cols + c as usize] = v;
@@ -147,7 +151,9 @@ fn rng_is_reproducible_and_uniform() {
     let mut a = Rng::new(7);
     let mut b = Rng::new(7);
     let xs: Vec<f64> = (0..10_000).map(|_| a.uniform()).collect();
-    assert!(xs.iter().all(|&x| (0.0..1.0).contains(&x) && x == b.uniform()));
+    assert!(xs
+        .iter()
+        .all(|&x| (0.0..1.0).contains(&x) && x == b.uniform()));
     let mean = xs.iter().sum::<f64>() / 1e4;
     assert!((mean - 0.5).abs() < 0.01, "mean {mean}");
 }
