@@ -8,12 +8,38 @@
 //!
 //! Principal types:
 //! - [`Mechanism`]: the trait generated code implements; [`Info`] describes a model.
+//! - [`MechanismExt`]: dense matrices, energy, constraint residuals, derivative checks.
+//! - [`Workspace`]: the per-model buffers, allocated once.
+//! - [`Partition`]: generalized coordinate partitioning (Algorithm P).
+//! - [`Kinematics`]: position (K1) and velocity (K2) analysis, the partition monitor,
+//!   and [assembly](Kinematics::assemble) of consistent initial conditions.
+//! - [`Dynamics`]: accelerations and multipliers from the augmented system, dense or
+//!   sparse, with minimum-norm multipliers for redundant constraints.
+//! - [`Error`]: every module's error, joined.
 
 pub use pfaff_macros::mechanism;
 
+mod assembly;
+mod dynamics;
+mod error;
+mod ext;
+mod kinematics;
+mod linalg;
 mod mechanism;
+mod partition;
+mod workspace;
 
+pub use assembly::{AssemblyError, AssemblyReport, Prescription};
+pub use dynamics::{
+    AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
+    DEFAULT_CROSSOVER,
+};
+pub use error::Error;
+pub use ext::{DerivativeCheck, MechanismExt, Residuals};
+pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
+pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
+pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Workspace};
 
 /// Items used by generated code. Not part of the public API.
 #[doc(hidden)]

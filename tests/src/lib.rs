@@ -1,4 +1,8 @@
 //! Integration, accuracy and snapshot tests of pfaff.
+//!
+//! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
 #[cfg(test)]
 mod accuracy;
+#[cfg(test)]
+mod ui;

@@ -140,8 +140,8 @@ pub fn not_quadratic(cx: &Ctxt, model: &Model, g: &mut Graph, m: ExprId, i: usiz
     cx.error_at(
         span,
         format!(
-            "the kinetic energy is not quadratic in the velocities: ∂²T/∂{}∂{} still depends on `{culprit}` \
-             (T must be T2 + T1 + T0, at most quadratic in the velocities)",
+            "the kinetic energy is not quadratic in the velocities: its second derivative with respect to \
+             `{}` and `{}` still depends on `{culprit}` (T must be T2 + T1 + T0)",
             velocity_name(model, i),
             velocity_name(model, j),
         ),

@@ -455,6 +455,20 @@ impl<'a> Translator<'a> {
             _ => None,
         };
         let Some(i) = coord else {
+            if let syn::Expr::Path(p) = &*m.receiver {
+                if let Some(id) = p.path.get_ident() {
+                    let known = self.locals.iter().any(|(n, _)| id == n)
+                        || self.model.param_index(&id.to_string()).is_some();
+                    if !known {
+                        let names: Vec<String> = self.model.coords.iter().map(|c| c.name.to_string()).collect();
+                        let hint = suggest(&id.to_string(), names.iter().map(String::as_str))
+                            .map(|n| format!("; did you mean `{n}`?"))
+                            .unwrap_or_default();
+                        self.cx.error_spanned_by(id, format!("unknown coordinate `{id}`{hint}"));
+                        return None;
+                    }
+                }
+            }
             self.cx.error_spanned_by(
                 &m.receiver,
                 "`.dot()` applies to a coordinate, as in `x.dot()`",

@@ -54,7 +54,8 @@ pub enum Var {
 /// A node of the DAG.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Node {
-    /// A constant, stored as `f64::to_bits` (with `-0.0` normalised to `0.0`).
+    /// A constant, stored as `f64::to_bits`. `-0.0` is normalised to `0.0`: signed
+    /// zeros are not preserved (only `atan2` on its branch cut could tell).
     Const(u64),
     /// A leaf variable.
     Var(Var),

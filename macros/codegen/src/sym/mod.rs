@@ -11,3 +11,6 @@ pub mod transform;
 
 pub use graph::{Deps, ExprId, Graph, Node, Var};
 pub use op::Func;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,285 @@
+//! Unit and property tests of the symbolic engine: identities of the canonical
+//! constructors, and random expressions whose simplified and unsimplified forms (and
+//! derivatives) must evaluate equal.
+
+use super::transform::{eval, rebuild};
+use super::*;
+
+/// splitmix64, seeded: reproducible random numbers without a dependency.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        #[allow(clippy::cast_precision_loss)]
+        let u = (self.next() >> 11) as f64 / (1u64 << 53) as f64;
+        lo + (hi - lo) * u
+    }
+}
+
+const VARS: [Var; 4] = [Var::Q(0), Var::Q(1), Var::Qd(0), Var::Time];
+
+fn env(vals: &[f64; 4]) -> impl Fn(Var) -> f64 + '_ {
+    move |v| match v {
+        Var::Q(0) => vals[0],
+        Var::Q(1) => vals[1],
+        Var::Qd(0) => vals[2],
+        Var::Time => vals[3],
+        _ => f64::NAN,
+    }
+}
+
+/// A random expression of bounded depth, built in `g` (raw or canonical alike).
+fn random_expr(g: &mut Graph, rng: &mut Rng, depth: u32) -> ExprId {
+    if depth == 0 || rng.below(4) == 0 {
+        return if rng.below(3) == 0 {
+            let c = [0.0, 1.0, -1.0, 2.0, 0.5, 3.0][rng.below(6) as usize];
+            g.constant(c)
+        } else {
+            g.var(VARS[rng.below(4) as usize])
+        };
+    }
+    match rng.below(12) {
+        0..=2 => {
+            let a = random_expr(g, rng, depth - 1);
+            let b = random_expr(g, rng, depth - 1);
+            g.add(vec![a, b])
+        }
+        3 => {
+            let a = random_expr(g, rng, depth - 1);
+            let b = random_expr(g, rng, depth - 1);
+            g.sub(a, b)
+        }
+        4..=5 => {
+            let a = random_expr(g, rng, depth - 1);
+            let b = random_expr(g, rng, depth - 1);
+            g.mul(vec![a, b])
+        }
+        6 => {
+            // Keep denominators away from zero: a / (1 + b²).
+            let a = random_expr(g, rng, depth - 1);
+            let b = random_expr(g, rng, depth - 1);
+            let one = g.constant(1.0);
+            let b2 = g.powi(b, 2);
+            let den = g.add(vec![one, b2]);
+            g.div(a, den)
+        }
+        7 => {
+            let a = random_expr(g, rng, depth - 1);
+            let n = [2, 3, -1, -2][rng.below(4) as usize];
+            if n < 0 {
+                let one = g.constant(1.0);
+                let a2 = g.powi(a, 2);
+                let s = g.add(vec![one, a2]);
+                g.powi(s, n)
+            } else {
+                g.powi(a, n)
+            }
+        }
+        8 => {
+            let a = random_expr(g, rng, depth - 1);
+            let f = [Func::Sin, Func::Cos, Func::Atan, Func::Tanh, Func::Sinh][rng.below(5) as usize];
+            g.call(f, a)
+        }
+        9 => {
+            // Functions with restricted domains get arguments inside it.
+            let a = random_expr(g, rng, depth - 1);
+            let one = g.constant(1.0);
+            let a2 = g.powi(a, 2);
+            let pos = g.add(vec![one, a2]);
+            let f = [Func::Sqrt, Func::Ln][rng.below(2) as usize];
+            g.call(f, pos)
+        }
+        10 => {
+            // atan2(a, 1 + b²): away from the branch cut, where the sign of a zero
+            // (not preserved by constant folding) would decide between ±π.
+            let a = random_expr(g, rng, depth - 1);
+            let b = random_expr(g, rng, depth - 1);
+            let one = g.constant(1.0);
+            let b2 = g.powi(b, 2);
+            let x = g.add(vec![one, b2]);
+            g.atan2(a, x)
+        }
+        _ => {
+            let a = random_expr(g, rng, depth - 1);
+            g.neg(a)
+        }
+    }
+}
+
+fn close(a: f64, b: f64, scale: f64) -> bool {
+    (a - b).abs() <= 1e-9 * (1.0 + scale)
+}
+
+fn x(g: &mut Graph) -> ExprId {
+    g.var(Var::Q(0))
+}
+
+#[test]
+fn identities_of_the_canonical_constructors() {
+    let mut g = Graph::new();
+    let x = x(&mut g);
+    let y = g.var(Var::Q(1));
+    let d = g.sub(x, x);
+    assert!(g.is_zero(d), "x - x = 0");
+    let q = g.div(x, x);
+    assert_eq!(g.as_const(q), Some(1.0), "x / x = 1");
+    let two = g.constant(2.0);
+    let three = g.constant(3.0);
+    let a = g.mul(vec![two, x]);
+    let b = g.mul(vec![three, x]);
+    let s = g.add(vec![a, b]);
+    let five = g.constant(5.0);
+    assert_eq!(s, g.mul(vec![five, x]), "2x + 3x = 5x");
+    let xy = g.mul(vec![x, y]);
+    assert_eq!(xy, g.mul(vec![y, x]), "commutative operands are ordered");
+    let xx = g.mul(vec![x, x]);
+    assert_eq!(xx, g.powi(x, 2), "x x = x²");
+    let s2 = g.call(Func::Sin, y);
+    let c2 = g.call(Func::Cos, y);
+    let s2 = g.powi(s2, 2);
+    let c2 = g.powi(c2, 2);
+    let lhs = g.mul(vec![three, x, s2]);
+    let rhs = g.mul(vec![three, x, c2]);
+    let pyth = g.add(vec![lhs, rhs]);
+    assert_eq!(pyth, g.mul(vec![three, x]), "3x sin²y + 3x cos²y = 3x");
+    let sq = g.call(Func::Sqrt, x);
+    assert_eq!(g.powi(sq, 2), x, "(√x)² = x");
+    let neg = g.neg(x);
+    let sn = g.call(Func::Sin, neg);
+    let sx = g.call(Func::Sin, x);
+    assert_eq!(sn, g.neg(sx), "sin(−x) = −sin x");
+    let cn = g.call(Func::Cos, neg);
+    assert_eq!(cn, g.call(Func::Cos, x), "cos(−x) = cos x");
+    let half = g.constant(0.5);
+    let sum = g.add(vec![a, b]);
+    let hs = g.mul(vec![half, sum]);
+    let e = g.sub(hs, x);
+    let c = g.constant(1.5);
+    let expect = g.mul(vec![c, x]);
+    assert_eq!(e, expect, "½(2x + 3x) − x = 1.5x");
+}
+
+#[test]
+fn hash_consing_shares_equal_subexpressions() {
+    let mut g = Graph::new();
+    let x = x(&mut g);
+    let a = g.call(Func::Sin, x);
+    let n = g.len();
+    let b = g.call(Func::Sin, x);
+    assert_eq!(a, b);
+    assert_eq!(g.len(), n, "no new node for an equal expression");
+}
+
+#[test]
+fn simplified_and_unsimplified_expressions_evaluate_equal() {
+    let mut rng = Rng(0x51_4D_B1);
+    let mut checked = 0;
+    for _ in 0..400 {
+        let mut raw = Graph::raw();
+        let e = random_expr(&mut raw, &mut rng, 5);
+        let mut canon = Graph::new();
+        let s = rebuild(&raw, &mut canon, &[e], &mut |g, v| g.var(v))[0];
+        for _ in 0..5 {
+            let vals = [
+                rng.uniform(-2.0, 2.0),
+                rng.uniform(-2.0, 2.0),
+                rng.uniform(-2.0, 2.0),
+                rng.uniform(-2.0, 2.0),
+            ];
+            let a = eval(&raw, &[e], &env(&vals))[0];
+            let b = eval(&canon, &[s], &env(&vals))[0];
+            if !a.is_finite() || a.abs() > 1e6 {
+                continue;
+            }
+            let name = |v: Var| format!("{v:?}");
+            assert!(
+                close(a, b, a.abs()),
+                "raw {a} vs simplified {b} at {vals:?}\n{}\n{}",
+                display::to_infix(&raw, e, &name),
+                display::to_infix(&canon, s, &name)
+            );
+            checked += 1;
+        }
+        assert!(canon.len() <= raw.len() + 8, "simplification does not blow up the graph");
+    }
+    assert!(checked > 1000, "enough finite samples were compared: {checked}");
+}
+
+#[test]
+fn derivatives_match_central_differences() {
+    let mut rng = Rng(0xD1FF);
+    let mut checked = 0;
+    for _ in 0..300 {
+        let mut g = Graph::new();
+        let e = random_expr(&mut g, &mut rng, 4);
+        for (k, &v) in VARS.iter().enumerate() {
+            let d = diff::differentiate(&mut g, e, v);
+            let vals = [
+                rng.uniform(-1.5, 1.5),
+                rng.uniform(-1.5, 1.5),
+                rng.uniform(-1.5, 1.5),
+                rng.uniform(-1.5, 1.5),
+            ];
+            let h = 1e-5;
+            let (mut p, mut m) = (vals, vals);
+            p[k] += h;
+            m[k] -= h;
+            let fp = eval(&g, &[e], &env(&p))[0];
+            let fm = eval(&g, &[e], &env(&m))[0];
+            let fd = (fp - fm) / (2.0 * h);
+            let an = eval(&g, &[d], &env(&vals))[0];
+            if !fd.is_finite() || !an.is_finite() || fd.abs() > 1e4 {
+                continue;
+            }
+            // Central differences: truncation O(h²·f''') plus rounding O(ε|f|/h).
+            let scale = fp.abs().max(fm.abs());
+            assert!(
+                (fd - an).abs() <= 1e-5 * (1.0 + an.abs()) + 1e-9 * scale / h,
+                "d/d{v:?}: symbolic {an} vs central difference {fd}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 500, "enough derivatives were compared: {checked}");
+}
+
+#[test]
+fn canonical_and_raw_derivatives_agree() {
+    let mut rng = Rng(0xCA0);
+    for _ in 0..200 {
+        let mut raw = Graph::raw();
+        let e = random_expr(&mut raw, &mut rng, 4);
+        let dr = diff::differentiate(&mut raw, e, Var::Q(0));
+        let mut canon = Graph::new();
+        let s = rebuild(&raw, &mut canon, &[e], &mut |g, v| g.var(v))[0];
+        let ds = diff::differentiate(&mut canon, s, Var::Q(0));
+        let vals = [0.3, -0.7, 1.1, 0.4];
+        let a = eval(&raw, &[dr], &env(&vals))[0];
+        let b = eval(&canon, &[ds], &env(&vals))[0];
+        if a.is_finite() && a.abs() < 1e6 {
+            assert!(close(a, b, a.abs()), "raw derivative {a} vs canonical {b}");
+        }
+    }
+}
+
+#[test]
+fn building_is_deterministic() {
+    let build = || {
+        let mut rng = Rng(7);
+        let mut g = Graph::new();
+        let roots: Vec<ExprId> = (0..20).map(|_| random_expr(&mut g, &mut rng, 5)).collect();
+        let d: Vec<ExprId> = roots.iter().map(|&r| diff::differentiate(&mut g, r, Var::Q(1))).collect();
+        let name = |v: Var| format!("{v:?}");
+        d.iter().map(|&e| display::to_infix(&g, e, &name)).collect::<Vec<_>>()
+    };
+    assert_eq!(build(), build());
+}

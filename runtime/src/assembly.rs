@@ -1,0 +1,175 @@
+//! Assembly: consistent initial conditions (math-spec §6, "Initial conditions").
+//!
+//! Input: a guess $(q, \dot q)$ and a [`Prescription`] of coordinates and velocities by
+//! name (e.g. `phi1 = π/6`, `phi1' = 10`). Output: $q$ with $C(q,t) = 0$ and $\dot q$
+//! with $C_q\dot q + C_t = 0$, $G\dot q + g = 0$, the prescribed values untouched.
+//!
+//! Steps: write the prescribed values; run Algorithm P keeping the prescribed
+//! coordinates out of $\beta$ and the coordinates with prescribed velocities in
+//! $\gamma$ (an error names the coordinate and the constraints that make this
+//! impossible); Newton K1 on $\beta$; the velocity solve K2 with the non-prescribed
+//! independent velocities taken from the guess.
+
+use crate::kinematics::{Kinematics, KinematicsError, NewtonStats};
+use crate::partition::{PartitionError, Preferences};
+use crate::workspace::{check_state, EvalError, Workspace};
+use crate::Mechanism;
+
+/// Prescribed values by coordinate name.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Prescription<'a> {
+    /// `(name, value)` of prescribed coordinates.
+    pub coordinates: &'a [(&'a str, f64)],
+    /// `(name, value)` of prescribed velocities.
+    pub velocities: &'a [(&'a str, f64)],
+}
+
+/// Outcome of an assembly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AssemblyReport {
+    /// The position solve.
+    pub newton: NewtonStats,
+    /// $\lVert q - q_{guess}\rVert_\infty$ (after writing the prescribed values).
+    pub position_correction: f64,
+    /// $\lVert \dot q - \dot q_{guess}\rVert_\infty$ (after writing the prescribed values).
+    pub velocity_correction: f64,
+    /// $\lVert [C_q\dot q + C_t;\ G\dot q + g]\rVert_\infty$ at the result.
+    pub velocity_residual: f64,
+}
+
+/// Errors of assembly.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum AssemblyError {
+    /// A prescribed name is not a coordinate of the model.
+    #[error("unknown coordinate `{name}` in the prescription, expected one of {expected:?}")]
+    UnknownCoordinate {
+        /// The name given.
+        name: String,
+        /// The model's coordinates.
+        expected: Vec<&'static str>,
+    },
+    /// A coordinate is prescribed twice.
+    #[error("coordinate `{name}` is prescribed twice")]
+    Duplicate {
+        /// The name.
+        name: &'static str,
+    },
+    /// The prescription cannot be honoured, or the constraints are redundant.
+    #[error("impossible prescription: {0}")]
+    Partition(#[from] PartitionError),
+    /// Newton could not meet the constraints from the guess, or a solve failed.
+    #[error("cannot assemble from the guess: {0}")]
+    Kinematics(#[from] KinematicsError),
+    /// Evaluation failed.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
+fn resolve(
+    info: &'static crate::Info,
+    list: &[(&str, f64)],
+    seen: &mut Vec<usize>,
+) -> Result<Vec<(usize, f64)>, AssemblyError> {
+    seen.clear();
+    list.iter()
+        .map(|&(name, v)| {
+            let i =
+                info.coordinate_index(name)
+                    .ok_or_else(|| AssemblyError::UnknownCoordinate {
+                        name: name.to_owned(),
+                        expected: info.coordinates.iter().map(|s| s.name).collect(),
+                    })?;
+            if seen.contains(&i) {
+                return Err(AssemblyError::Duplicate {
+                    name: info.coordinates[i].name,
+                });
+            }
+            seen.push(i);
+            if !v.is_finite() {
+                return Err(EvalError::NonFinite {
+                    quantity: crate::Quantity::Coordinates,
+                    t: f64::NAN,
+                    row: i,
+                    col: None,
+                    value: v,
+                }
+                .into());
+            }
+            Ok((i, v))
+        })
+        .collect()
+}
+
+impl Kinematics {
+    /// Makes $(q, \dot q)$ consistent at time `t`, holding the prescribed values; the
+    /// partition used becomes current (it is not counted as a re-partition).
+    pub fn assemble<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        prescription: &Prescription<'_>,
+    ) -> Result<AssemblyReport, AssemblyError> {
+        let info = ws.info();
+        check_state(info, t, q, Some(qd))?;
+        let mut seen = Vec::new();
+        let pos = resolve(info, prescription.coordinates, &mut seen)?;
+        let vel = resolve(info, prescription.velocities, &mut seen)?;
+        for &(i, v) in &pos {
+            q[i] = v;
+        }
+        for &(i, v) in &vel {
+            qd[i] = v;
+        }
+        let (q0, qd0) = (q.to_vec(), qd.to_vec());
+        let pos_idx: Vec<usize> = pos.iter().map(|p| p.0).collect();
+        let vel_idx: Vec<usize> = vel.iter().map(|p| p.0).collect();
+        let previous = self.partition.take();
+        let prefs = Preferences {
+            coordinates: &pos_idx,
+            velocities: &vel_idx,
+        };
+        if let Err(e) = self.repartition_with(mech, ws, t, q, prefs) {
+            self.partition = previous;
+            return Err(e.into());
+        }
+        let newton = self.position(mech, ws, t, q)?;
+        self.velocity(mech, ws, t, q, qd)?;
+        let velocity_residual = velocity_residual(ws, mech, t, q, qd)?;
+        let diff = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .fold(0.0_f64, |acc, (x, y)| acc.max((x - y).abs()))
+        };
+        Ok(AssemblyReport {
+            newton,
+            position_correction: diff(q, &q0),
+            velocity_correction: diff(qd, &qd0),
+            velocity_residual,
+        })
+    }
+}
+
+/// $\lVert [C_q\dot q + C_t;\ G\dot q + g]\rVert_\infty$ using the workspace buffers.
+pub(crate) fn velocity_residual<M: Mechanism + ?Sized>(
+    ws: &mut Workspace,
+    mech: &M,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<f64, EvalError> {
+    let info = ws.info();
+    let (n, mh) = (info.nq(), info.nh());
+    ws.eval_jacobian(mech, t, q)?;
+    ws.eval_rates(mech, t, q)?;
+    let mut r = 0.0_f64;
+    for i in 0..mh + info.nnh() {
+        let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
+        let row = &ws.jacobian[i * n..(i + 1) * n];
+        let v: f64 = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + c;
+        r = r.max(v.abs());
+    }
+    Ok(r)
+}

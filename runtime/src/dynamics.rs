@@ -1,0 +1,432 @@
+//! Accelerations and multipliers from the augmented system (math-spec §5, E31).
+//!
+//! Input: $(q, \dot q, t)$ and a [`Workspace`]. Output: $\ddot q$ and
+//! $\lambda = [\lambda_h; \lambda_{nh}]$ solving
+//! $$\begin{bmatrix}M & J^\mathsf{T}\\ J & 0\end{bmatrix}
+//!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
+//!   \begin{bmatrix}Q\\ \gamma\end{bmatrix},\qquad J = \begin{bmatrix}C_q\\ G\end{bmatrix},
+//!   \quad \gamma = \begin{bmatrix}\gamma_h\\ \gamma_{nh}\end{bmatrix},$$
+//! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of math-spec §1).
+//!
+//! **Paths.** A dense $LU$ with complete pivoting for small systems, a sparse $LU$
+//! (symbolic factorization once from the patterns, numeric each call) for large ones;
+//! [`LinearSolver::Auto`] switches at [`DynamicsParams::crossover`] unknowns.
+//!
+//! **Redundant constraints.** When the dense pivots (ratio below
+//! [`DynamicsParams::rank_tolerance`]) or the sparse residual reveal a singular
+//! system, complete pivoting on $J$ finds a maximal independent row set $R$ and the
+//! redundant rows $D$ (reported by name, [`Dynamics::redundant_constraints`]). The
+//! reduced system with $J_R$ gives $\ddot q$ (unique when $M$ is positive definite on
+//! $\ker J$) and $\lambda_R$. Writing $J = T J_R$ with $T_R = I$ and
+//! $T_D = J_D J_R^\mathsf{T}(J_R J_R^\mathsf{T})^{-1}$, every $\lambda$ with
+//! $J^\mathsf{T}\lambda = J_R^\mathsf{T}\lambda_R$ satisfies $T^\mathsf{T}\lambda =
+//! \lambda_R$, and the one of least 2-norm is
+//! $\lambda = T (T^\mathsf{T}T)^{-1}\lambda_R$ (for a duplicated row: an equal
+//! split). The redundant rows' $\gamma$ must agree with $\ddot q$, otherwise
+//! [`DynamicsError::InconsistentRedundant`].
+//!
+//! Invariant: the dense and sparse paths do not allocate after the first call; the
+//! redundant path allocates.
+
+use crate::linalg::dense::DenseLu;
+use crate::linalg::elimination::Elimination;
+use crate::linalg::inf_norm;
+use crate::linalg::sparse::SparseKkt;
+use crate::workspace::{
+    check_finite, check_len, check_state, scatter_row_major, EvalError, Quantity, Workspace,
+};
+use crate::{Info, Mechanism};
+
+/// Choice of the linear solver for the augmented system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LinearSolver {
+    /// Dense below [`DynamicsParams::crossover`] unknowns, sparse from there on.
+    #[default]
+    Auto,
+    /// Always dense.
+    Dense,
+    /// Always sparse.
+    Sparse,
+}
+
+/// Tuning of [`Dynamics`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicsParams {
+    /// Which linear solver.
+    pub solver: LinearSolver,
+    /// Size $n + m$ from which [`LinearSolver::Auto`] uses the sparse $LU$.
+    pub crossover: usize,
+    /// Relative pivot size below which the augmented matrix (dense path) or $J$ (the
+    /// redundancy search) counts as rank deficient.
+    pub rank_tolerance: f64,
+    /// Relative residual above which a sparse solution is rejected (then the redundant
+    /// path runs).
+    pub residual_tolerance: f64,
+}
+
+impl Default for DynamicsParams {
+    fn default() -> Self {
+        Self {
+            solver: LinearSolver::Auto,
+            crossover: DEFAULT_CROSSOVER,
+            rank_tolerance: 1e-10,
+            residual_tolerance: 1e-10,
+        }
+    }
+}
+
+/// Default crossover between the dense and the sparse path (unknowns $n + m$).
+///
+/// Measured on the planar pendulum chain (`runtime/tests/kin_chain.rs`, release, one
+/// core): at $n + m = 12$ dense 1.7 µs vs sparse 1.4 µs, at 24: 5.9 vs 3.5 µs, at 96:
+/// 171 vs 9 µs, at 384: 7–11 ms vs 36–47 µs. The chain is as sparse as models get, so
+/// the switch sits a little above the measured break-even (≈ 10) to leave the tiny
+/// systems, where both take a few µs, to the rank-revealing dense factorization.
+pub const DEFAULT_CROSSOVER: usize = 16;
+
+/// Which path solved the system.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverPath {
+    /// Dense complete-pivoting $LU$.
+    Dense,
+    /// Sparse $LU$.
+    Sparse,
+    /// Rank-deficient $J$: reduced system and minimum-norm multipliers.
+    Redundant,
+}
+
+/// Statistics of one acceleration solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelerationStats {
+    /// The path that produced the result.
+    pub path: SolverPath,
+    /// Numerical rank of $J$ ($= m$ unless [`SolverPath::Redundant`]).
+    pub rank: usize,
+    /// Smallest / largest pivot of the dense factorization used (1 on the sparse path).
+    pub pivot_ratio: f64,
+}
+
+/// Errors of the acceleration solve.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DynamicsError {
+    /// The augmented matrix is singular although $J$ has full rank (or the reduced one
+    /// is singular): $M$ is not positive definite on $\ker J$.
+    #[error("augmented system singular at t = {t} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space")]
+    Singular {
+        /// Time.
+        t: f64,
+        /// Rank of $J$.
+        rank: usize,
+        /// Smallest / largest pivot.
+        ratio: f64,
+    },
+    /// Redundant constraints whose acceleration terms contradict the others.
+    #[error("redundant constraints {constraints:?} are inconsistent at t = {t}: acceleration residual {residual:e}")]
+    InconsistentRedundant {
+        /// Time.
+        t: f64,
+        /// The redundant constraints.
+        constraints: Vec<&'static str>,
+        /// $\max_D |J_D\ddot q - \gamma_D|$.
+        residual: f64,
+    },
+    /// The sparse symbolic factorization failed.
+    #[error("sparse symbolic factorization of the augmented matrix of `{model}` failed: {reason}")]
+    Symbolic {
+        /// The model.
+        model: &'static str,
+        /// faer's report.
+        reason: String,
+    },
+    /// Evaluation failed, or the result is not finite.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
+/// Acceleration analysis for one model.
+#[derive(Debug)]
+pub struct Dynamics {
+    params: DynamicsParams,
+    info: &'static Info,
+    dense: Option<DenseLu>,
+    sparse: Option<SparseKkt>,
+    x: Vec<f64>,
+    b: Vec<f64>,
+    r: Vec<f64>,
+    redundant: Vec<usize>,
+}
+
+impl Dynamics {
+    /// Scratch for the model described by `info`; the sparse symbolic factorization is
+    /// computed here when the sparse path can be taken.
+    pub fn new(info: &'static Info, params: DynamicsParams) -> Result<Self, DynamicsError> {
+        let dim = info.nq() + info.nh() + info.nnh();
+        let (dense, sparse) = match params.solver {
+            LinearSolver::Dense => (true, false),
+            LinearSolver::Sparse => (false, true),
+            LinearSolver::Auto => (dim < params.crossover, dim >= params.crossover),
+        };
+        let sparse = if sparse {
+            Some(SparseKkt::new(info).map_err(|e| DynamicsError::Symbolic {
+                model: info.name,
+                reason: format!("{e:?}"),
+            })?)
+        } else {
+            None
+        };
+        Ok(Self {
+            params,
+            info,
+            dense: dense.then(|| DenseLu::new(dim, 1)),
+            sparse,
+            x: vec![0.0; dim],
+            b: vec![0.0; dim],
+            r: vec![0.0; dim],
+            redundant: Vec::with_capacity(info.nh() + info.nnh()),
+        })
+    }
+
+    /// The tuning parameters.
+    #[must_use]
+    pub fn params(&self) -> &DynamicsParams {
+        &self.params
+    }
+
+    /// Stored entries of the sparse augmented matrix (0 when the sparse path is off).
+    #[must_use]
+    pub fn sparse_nnz(&self) -> usize {
+        self.sparse.as_ref().map_or(0, SparseKkt::nnz)
+    }
+
+    /// Constraints found redundant by the last solve (empty unless its path was
+    /// [`SolverPath::Redundant`]).
+    pub fn redundant_constraints(&self) -> impl Iterator<Item = &'static str> + '_ {
+        let info = self.info;
+        let mh = info.nh();
+        self.redundant.iter().map(move |&r| {
+            if r < mh {
+                info.holonomic[r].name
+            } else {
+                info.nonholonomic[r - mh].name
+            }
+        })
+    }
+
+    /// Solves (E31) at $(q, \dot q, t)$: writes $\ddot q$ (length $n$) and
+    /// $\lambda = [\lambda_h; \lambda_{nh}]$ (length $m$).
+    #[allow(clippy::too_many_arguments)]
+    pub fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<AccelerationStats, DynamicsError> {
+        let info = self.info;
+        let (n, m) = (info.nq(), info.nh() + info.nnh());
+        check_state(info, t, q, Some(qd))?;
+        check_len(Quantity::Accelerations, qdd, n)?;
+        check_len(Quantity::Multipliers, lambda, m)?;
+        ws.eval_mass_and_forces(mech, t, q, qd)?;
+        ws.eval_jacobian_values(mech, t, q)?;
+        ws.eval_gamma(mech, t, q, qd)?;
+        self.b[..n].copy_from_slice(&ws.forces);
+        self.b[n..].copy_from_slice(&ws.gamma);
+        self.redundant.clear();
+
+        let stats = if let Some(lu) = self.dense.as_mut() {
+            fill_dense(lu, info, ws, None);
+            let ratio = lu.factor().ratio();
+            if ratio > self.params.rank_tolerance {
+                self.x.copy_from_slice(&self.b);
+                lu.solve_vec(&mut self.x);
+                Some(AccelerationStats {
+                    path: SolverPath::Dense,
+                    rank: m,
+                    pivot_ratio: ratio,
+                })
+            } else {
+                None
+            }
+        } else if let Some(kkt) = self.sparse.as_mut() {
+            kkt.fill(&ws.mass_values, &ws.cq_values, &ws.g_values);
+            if kkt.factor().is_ok() {
+                self.x.copy_from_slice(&self.b);
+                kkt.solve_in_place(&mut self.x);
+                let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);
+                (res <= self.params.residual_tolerance * scale).then_some(AccelerationStats {
+                    path: SolverPath::Sparse,
+                    rank: m,
+                    pivot_ratio: 1.0,
+                })
+            } else {
+                None
+            }
+        } else {
+            unreachable!("Dynamics::new enables at least one path")
+        };
+        let stats = match stats {
+            Some(s) => s,
+            None => self.solve_redundant(ws, t)?,
+        };
+        check_finite(Quantity::Accelerations, t, &self.x[..n])?;
+        check_finite(Quantity::Multipliers, t, &self.x[n..])?;
+        qdd.copy_from_slice(&self.x[..n]);
+        lambda.copy_from_slice(&self.x[n..]);
+        Ok(stats)
+    }
+
+    /// The rank-deficient path (allocates).
+    #[allow(non_snake_case)]
+    fn solve_redundant(
+        &mut self,
+        ws: &mut Workspace,
+        t: f64,
+    ) -> Result<AccelerationStats, DynamicsError> {
+        let info = self.info;
+        let (n, mh) = (info.nq(), info.nh());
+        let m = mh + info.nnh();
+        {
+            let (h, nh) = ws.jacobian.split_at_mut(mh * n);
+            scatter_row_major(info.holonomic_pattern, &ws.cq_values, n, h);
+            scatter_row_major(info.nonholonomic_pattern, &ws.g_values, n, nh);
+        }
+        let J = &ws.jacobian;
+        let mut elim = Elimination::new(m, n);
+        elim.load(J);
+        let rank = elim.phase(0, m, m, self.params.rank_tolerance).rank;
+        if rank == m {
+            let mut lu = DenseLu::new(n + m, 1);
+            fill_dense(&mut lu, info, ws, None);
+            return Err(DynamicsError::Singular {
+                t,
+                rank,
+                ratio: lu.factor().ratio(),
+            });
+        }
+        let rows_r: Vec<usize> = elim.rows[..rank].to_vec();
+        let rows_d: Vec<usize> = elim.rows[rank..].to_vec();
+        self.redundant.extend_from_slice(&rows_d);
+        let row = |i: usize| &J[i * n..(i + 1) * n];
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+
+        // Reduced augmented system with the independent rows.
+        let mut lu = DenseLu::new(n + rank, 1);
+        fill_dense(&mut lu, info, ws, Some(&rows_r));
+        let ratio = lu.factor().ratio();
+        if ratio.is_nan() || ratio <= self.params.rank_tolerance {
+            return Err(DynamicsError::Singular { t, rank, ratio });
+        }
+        let mut x = vec![0.0; n + rank];
+        x[..n].copy_from_slice(&self.b[..n]);
+        for (k, &i) in rows_r.iter().enumerate() {
+            x[n + k] = self.b[n + i];
+        }
+        lu.solve_vec(&mut x);
+        let qdd = &x[..n];
+
+        // The redundant rows must be satisfied by q̈ too.
+        let mut residual = 0.0_f64;
+        let mut scale = 0.0_f64;
+        for &d in &rows_d {
+            let jd = row(d);
+            residual = residual.max((dot(jd, qdd) - self.b[n + d]).abs());
+            scale = scale.max(inf_norm(jd) * inf_norm(qdd) + self.b[n + d].abs());
+        }
+        if residual.is_nan() || residual > 1e-8 * scale.max(f64::MIN_POSITIVE) {
+            return Err(DynamicsError::InconsistentRedundant {
+                t,
+                constraints: self.redundant_constraints().collect(),
+                residual,
+            });
+        }
+
+        // Minimum-norm multipliers: T_D = J_D J_Rᵀ (J_R J_Rᵀ)⁻¹, λ = T (TᵀT)⁻¹ λ_R.
+        let (r, d) = (rank, rows_d.len());
+        let mut s_lu = DenseLu::new(r, d.max(r));
+        {
+            let mut s = s_lu.matrix_mut();
+            for a in 0..r {
+                for b in 0..r {
+                    s[(a, b)] = dot(row(rows_r[a]), row(rows_r[b]));
+                }
+            }
+        }
+        s_lu.factor();
+        // X = S⁻¹ J_R J_Dᵀ (r × d); T_D = Xᵀ since S is symmetric.
+        let mut X = faer::Mat::<f64>::zeros(r, d);
+        for a in 0..r {
+            for b in 0..d {
+                X[(a, b)] = dot(row(rows_r[a]), row(rows_d[b]));
+            }
+        }
+        s_lu.solve_in_place(X.as_mut());
+        let mut a_lu = DenseLu::new(r, 1);
+        {
+            let mut a = a_lu.matrix_mut();
+            for i in 0..r {
+                for j in 0..r {
+                    let mut v = if i == j { 1.0 } else { 0.0 };
+                    for k in 0..d {
+                        v += X[(i, k)] * X[(j, k)];
+                    }
+                    a[(i, j)] = v;
+                }
+            }
+        }
+        a_lu.factor();
+        let mut y = x[n..].to_vec();
+        a_lu.solve_vec(&mut y);
+        self.x[..n].copy_from_slice(qdd);
+        for (k, &i) in rows_r.iter().enumerate() {
+            self.x[n + i] = y[k];
+        }
+        for (k, &i) in rows_d.iter().enumerate() {
+            self.x[n + i] = (0..r).map(|a| X[(a, k)] * y[a]).sum();
+        }
+        Ok(AccelerationStats {
+            path: SolverPath::Redundant,
+            rank,
+            pivot_ratio: ratio,
+        })
+    }
+}
+
+/// Writes $\begin{bmatrix}M & J_R^\mathsf{T}\\ J_R & 0\end{bmatrix}$ into `lu`, with
+/// $J_R$ the rows `rows` of $J$ (all rows when `None`).
+fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usize]>) {
+    let n = info.nq();
+    let mh = info.nh();
+    let dim = lu.dim();
+    let mut a = lu.matrix_mut();
+    for j in 0..dim {
+        for i in 0..dim {
+            a[(i, j)] = 0.0;
+        }
+    }
+    for (&(r, c), &v) in info.mass_pattern.iter().zip(&ws.mass_values) {
+        a[(r as usize, c as usize)] = v;
+    }
+    // Position of constraint row `i` in the reduced system, if kept.
+    let slot = |i: usize| -> Option<usize> {
+        match rows {
+            None => Some(i),
+            Some(rows) => rows.iter().position(|&k| k == i),
+        }
+    };
+    let blocks = [
+        (info.holonomic_pattern, &ws.cq_values, 0),
+        (info.nonholonomic_pattern, &ws.g_values, mh),
+    ];
+    for (pattern, values, offset) in blocks {
+        for (&(r, c), &v) in pattern.iter().zip(values.iter()) {
+            if let Some(k) = slot(r as usize + offset) {
+                a[(n + k, c as usize)] = v;
+                a[(c as usize, n + k)] = v;
+            }
+        }
+    }
+}

@@ -1,0 +1,27 @@
+//! The crate-level error: every module's error enum, joined with `#[from]`.
+
+use crate::assembly::AssemblyError;
+use crate::dynamics::DynamicsError;
+use crate::kinematics::KinematicsError;
+use crate::partition::PartitionError;
+use crate::workspace::EvalError;
+
+/// Any error of the runtime's analyses.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// Evaluation of the model.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+    /// Coordinate partitioning.
+    #[error(transparent)]
+    Partition(#[from] PartitionError),
+    /// Position or velocity analysis.
+    #[error(transparent)]
+    Kinematics(#[from] KinematicsError),
+    /// Assembly of initial conditions.
+    #[error(transparent)]
+    Assembly(#[from] AssemblyError),
+    /// Accelerations and multipliers.
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+}

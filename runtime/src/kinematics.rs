@@ -1,0 +1,404 @@
+//! Kinematic analysis with a coordinate partition (math-spec §6, Algorithm K).
+//!
+//! - **K1, position** ([`Kinematics::position`]): Newton–Raphson on the dependent
+//!   coordinates $\beta$ with $p = [\eta; \gamma]$ fixed,
+//!   $C_\beta\,\Delta\beta = -C(\beta, p, t)$, until
+//!   $\lVert\Delta\beta\rVert_\infty \le \varepsilon(1 + \lVert\beta\rVert_\infty)$ and
+//!   $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$.
+//! - **K2, velocity** ([`Kinematics::velocity`]): the dependent velocities from (E34),
+//!   $J_d [\dot\beta; \dot\eta] = -J_\gamma \dot\gamma - [C_t; g]$.
+//! - **Monitor** ([`Kinematics::monitor`]): recompute the pivot ratios of the current
+//!   partition and re-partition (Algorithm P) when they deteriorate; re-partitions are
+//!   counted.
+//!
+//! Input: a [`Workspace`] of the same model, $(q, t)$ and $\dot q$. Output: $q$ and
+//! $\dot q$ corrected in place. The [`Kinematics`] struct holds the partition (a cache)
+//! and scratch, never the state. Invariant: after [`Kinematics::new`], K1, K2 and the
+//! monitor do not allocate unless they re-partition.
+
+use crate::linalg::dense::DenseLu;
+use crate::linalg::elimination::Elimination;
+use crate::linalg::inf_norm;
+use crate::partition::{
+    compute_with, condition_with, Condition, Partition, PartitionError, PartitionParams,
+    Preferences,
+};
+use crate::workspace::{check_state, EvalError, Workspace};
+use crate::{Info, Mechanism};
+
+/// Tuning of the Newton iteration K1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonParams {
+    /// Relative tolerance $\varepsilon$ on the step and on the residual.
+    pub tolerance: f64,
+    /// Iteration cap.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-12,
+            max_iterations: 25,
+        }
+    }
+}
+
+/// Tuning of [`Kinematics`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct KinematicsParams {
+    /// Newton iteration K1.
+    pub newton: NewtonParams,
+    /// Algorithm P and its monitor.
+    pub partition: PartitionParams,
+}
+
+/// Statistics of one K1 solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonStats {
+    /// Newton updates performed (0 when the guess already satisfies the constraints).
+    pub iterations: usize,
+    /// Final $\lVert C\rVert_\infty$.
+    pub residual: f64,
+    /// Last $\lVert\Delta\beta\rVert_\infty$.
+    pub step: f64,
+}
+
+/// Errors of kinematic analysis.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum KinematicsError {
+    /// Newton did not converge.
+    #[error("position analysis failed at t = {t} after {iterations} iterations: residual {residual:e}, violated constraints {violated:?}")]
+    NewtonFailed {
+        /// Time.
+        t: f64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Final $\lVert C\rVert_\infty$.
+        residual: f64,
+        /// Constraints whose residual exceeds the tolerance.
+        violated: Vec<&'static str>,
+    },
+    /// $C_\beta$ became singular during Newton.
+    #[error("dependent Jacobian `C_beta` is singular at t = {t}, iteration {iteration} (pivot ratio {ratio:e}); re-partition")]
+    SingularDependent {
+        /// Time.
+        t: f64,
+        /// Iteration at which it happened.
+        iteration: usize,
+        /// Smallest / largest pivot.
+        ratio: f64,
+    },
+    /// $J_d$ is singular in the velocity solve.
+    #[error("dependent velocity Jacobian `J_d` is singular at t = {t} (pivot ratio {ratio:e}); re-partition")]
+    SingularVelocity {
+        /// Time.
+        t: f64,
+        /// Smallest / largest pivot.
+        ratio: f64,
+    },
+    /// Algorithm P failed.
+    #[error(transparent)]
+    Partition(#[from] PartitionError),
+    /// Evaluation failed.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
+/// Pivot ratio below which a dense dependent block counts as singular.
+const SINGULAR_RATIO: f64 = 1e-14;
+
+/// Kinematic analysis (Algorithms P and K) for one model.
+#[derive(Debug)]
+pub struct Kinematics {
+    pub(crate) params: KinematicsParams,
+    pub(crate) elim: Elimination,
+    lu_h: DenseLu,
+    lu_d: DenseLu,
+    pub(crate) partition: Option<Partition>,
+    repartitions: usize,
+    history: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl Kinematics {
+    /// Scratch for the model described by `info`.
+    #[must_use]
+    pub fn new(info: &'static Info, params: KinematicsParams) -> Self {
+        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        Self {
+            params,
+            elim: Elimination::new(m, n),
+            lu_h: DenseLu::new(mh, 1),
+            lu_d: DenseLu::new(m, 1),
+            partition: None,
+            repartitions: 0,
+            history: Vec::with_capacity(params.newton.max_iterations + 1),
+            rhs: vec![0.0; m],
+        }
+    }
+
+    /// The tuning parameters.
+    #[must_use]
+    pub fn params(&self) -> &KinematicsParams {
+        &self.params
+    }
+
+    /// The current partition, if any.
+    #[must_use]
+    pub fn partition(&self) -> Option<&Partition> {
+        self.partition.as_ref()
+    }
+
+    /// Replaces the partition (not counted as a re-partition).
+    pub fn set_partition(&mut self, partition: Partition) {
+        self.partition = Some(partition);
+    }
+
+    /// Number of re-partitions (partitions computed while one already existed).
+    #[must_use]
+    pub fn repartitions(&self) -> usize {
+        self.repartitions
+    }
+
+    /// $\lVert C\rVert_\infty$ after each iteration of the last K1 solve (the first
+    /// entry is the initial residual).
+    #[must_use]
+    pub fn residual_history(&self) -> &[f64] {
+        &self.history
+    }
+
+    /// Runs Algorithm P at $(q, t)$ and makes the result current.
+    pub fn repartition<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+    ) -> Result<&Partition, PartitionError> {
+        self.repartition_with(mech, ws, t, q, Preferences::default())
+    }
+
+    pub(crate) fn repartition_with<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+        prefs: Preferences<'_>,
+    ) -> Result<&Partition, PartitionError> {
+        let p = compute_with(
+            &mut self.elim,
+            mech,
+            ws,
+            t,
+            q,
+            prefs,
+            &self.params.partition,
+        )?;
+        if self.partition.is_some() {
+            self.repartitions += 1;
+        }
+        Ok(self.partition.insert(p))
+    }
+
+    fn ensure_partition<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), PartitionError> {
+        if self.partition.is_none() {
+            self.repartition(mech, ws, t, q)?;
+        }
+        Ok(())
+    }
+
+    /// Pivot ratios of the current partition at $(q, t)$ (partitions first if there is
+    /// no partition yet).
+    pub fn condition<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+    ) -> Result<Condition, KinematicsError> {
+        self.ensure_partition(mech, ws, t, q)?;
+        let Self {
+            elim, partition, ..
+        } = self;
+        let p = partition.as_ref().expect("partition ensured above");
+        Ok(condition_with(elim, p, mech, ws, t, q)?)
+    }
+
+    /// The condition monitor: re-partitions when the pivot ratios fell below
+    /// `deterioration` × their reference values. Returns whether it re-partitioned.
+    pub fn monitor<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+    ) -> Result<bool, KinematicsError> {
+        let now = self.condition(mech, ws, t, q)?;
+        let p = self
+            .partition
+            .as_ref()
+            .expect("partition ensured by condition");
+        if p.is_deteriorated(now, &self.params.partition) {
+            self.repartition(mech, ws, t, q)?;
+            Ok(true)
+        } else {
+            Ok(false)
+        }
+    }
+
+    /// K1: Newton–Raphson on $\beta$ with $p$ fixed; corrects `q` in place.
+    pub fn position<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+    ) -> Result<NewtonStats, KinematicsError> {
+        let info = ws.info();
+        check_state(info, t, q, None)?;
+        self.ensure_partition(mech, ws, t, q)?;
+        let (n, mh) = (info.nq(), info.nh());
+        let Self {
+            params,
+            lu_h,
+            partition,
+            history,
+            ..
+        } = self;
+        let beta = &partition
+            .as_ref()
+            .expect("partition ensured above")
+            .dependent;
+        let tol = params.newton.tolerance;
+        history.clear();
+        ws.eval_constraints(mech, t, q)?;
+        let mut residual = inf_norm(&ws.c);
+        history.push(residual);
+        let c_tol = |q: &[f64]| tol * (1.0 + inf_norm(q));
+        if residual <= c_tol(q) {
+            return Ok(NewtonStats {
+                iterations: 0,
+                residual,
+                step: 0.0,
+            });
+        }
+        let mut step = f64::INFINITY;
+        for iteration in 1..=params.newton.max_iterations {
+            ws.eval_jacobian(mech, t, q)?;
+            {
+                let mut a = lu_h.matrix_mut();
+                for i in 0..mh {
+                    for (k, &j) in beta.iter().enumerate() {
+                        a[(i, k)] = ws.jacobian[i * n + j];
+                    }
+                }
+            }
+            let ratio = lu_h.factor().ratio();
+            if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+                return Err(KinematicsError::SingularDependent {
+                    t,
+                    iteration,
+                    ratio,
+                });
+            }
+            let dx = &mut ws.c;
+            for v in dx.iter_mut() {
+                *v = -*v;
+            }
+            lu_h.solve_vec(dx);
+            step = 0.0;
+            let mut beta_norm = 0.0_f64;
+            for (k, &j) in beta.iter().enumerate() {
+                q[j] += dx[k];
+                step = step.max(dx[k].abs());
+                beta_norm = beta_norm.max(q[j].abs());
+            }
+            ws.eval_constraints(mech, t, q)?;
+            residual = inf_norm(&ws.c);
+            if history.len() < history.capacity() {
+                history.push(residual);
+            }
+            if step <= tol * (1.0 + beta_norm) && residual <= c_tol(q) {
+                return Ok(NewtonStats {
+                    iterations: iteration,
+                    residual,
+                    step,
+                });
+            }
+            if !residual.is_finite() {
+                break;
+            }
+        }
+        let bound = c_tol(q);
+        let violated =
+            ws.c.iter()
+                .zip(info.holonomic)
+                .filter(|(c, _)| c.is_nan() || c.abs() > bound)
+                .map(|(_, s)| s.name)
+                .collect();
+        let _ = step;
+        Err(KinematicsError::NewtonFailed {
+            t,
+            iterations: history.len() - 1,
+            residual,
+            violated,
+        })
+    }
+
+    /// K2: dependent velocities $[\dot\beta; \dot\eta]$ from (E34), keeping
+    /// $\dot\gamma$; corrects `qd` in place.
+    pub fn velocity<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+    ) -> Result<(), KinematicsError> {
+        let info = ws.info();
+        check_state(info, t, q, Some(qd))?;
+        self.ensure_partition(mech, ws, t, q)?;
+        let (n, mh) = (info.nq(), info.nh());
+        let m = mh + info.nnh();
+        ws.eval_jacobian(mech, t, q)?;
+        ws.eval_rates(mech, t, q)?;
+        let Self {
+            lu_d,
+            partition,
+            rhs,
+            ..
+        } = self;
+        let p = partition.as_ref().expect("partition ensured above");
+        let dep = || p.dependent.iter().chain(&p.eta);
+        {
+            let mut a = lu_d.matrix_mut();
+            for i in 0..m {
+                for (k, &j) in dep().enumerate() {
+                    a[(i, k)] = ws.jacobian[i * n + j];
+                }
+            }
+        }
+        for (i, r) in rhs.iter_mut().enumerate() {
+            let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
+            let row = &ws.jacobian[i * n..(i + 1) * n];
+            *r = -c - p.independent.iter().map(|&j| row[j] * qd[j]).sum::<f64>();
+        }
+        let ratio = lu_d.factor().ratio();
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(KinematicsError::SingularVelocity { t, ratio });
+        }
+        lu_d.solve_vec(rhs);
+        for (k, j) in dep().enumerate() {
+            qd[*j] = rhs[k];
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,137 @@
+//! Dense $LU$ with complete pivoting, $P A Q = L U$, on a reusable buffer.
+//!
+//! Input: a square matrix written into [`DenseLu::matrix_mut`]. Output: the factors in
+//! place, the permutations, and the pivot magnitudes (the diagonal of $U$, which with
+//! complete pivoting is non-increasing in exact arithmetic and reveals the rank).
+//! Invariant: no allocation after [`DenseLu::new`].
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::full_pivoting::{factor, solve};
+use faer::perm::PermRef;
+use faer::{Mat, MatMut, Par};
+
+/// Pivot magnitudes of a factorization: $\max_k |u_{kk}|$ and $\min_k |u_{kk}|$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Pivots {
+    pub max: f64,
+    pub min: f64,
+}
+
+impl Pivots {
+    /// $\min|u_{kk}| / \max|u_{kk}|$; 1 for an empty matrix, 0 when singular or not finite.
+    pub fn ratio(self) -> f64 {
+        if self.max == 0.0 && self.min == 0.0 {
+            return 0.0;
+        }
+        let r = self.min / self.max;
+        if r.is_finite() {
+            r
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A reusable complete-pivoting $LU$ of an `n × n` matrix.
+pub(crate) struct DenseLu {
+    n: usize,
+    a: Mat<f64>,
+    row_fwd: Vec<usize>,
+    row_inv: Vec<usize>,
+    col_fwd: Vec<usize>,
+    col_inv: Vec<usize>,
+    mem: MemBuffer,
+    rhs_cols: usize,
+}
+
+impl std::fmt::Debug for DenseLu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DenseLu")
+            .field("n", &self.n)
+            .finish_non_exhaustive()
+    }
+}
+
+impl DenseLu {
+    /// Buffers for an `n × n` matrix and right-hand sides of up to `rhs_cols` columns.
+    pub fn new(n: usize, rhs_cols: usize) -> Self {
+        let req = StackReq::any_of(&[
+            factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
+            solve::solve_in_place_scratch::<usize, f64>(n, rhs_cols.max(1), Par::Seq),
+        ]);
+        Self {
+            n,
+            a: Mat::zeros(n, n),
+            row_fwd: vec![0; n],
+            row_inv: vec![0; n],
+            col_fwd: vec![0; n],
+            col_inv: vec![0; n],
+            mem: MemBuffer::new(req),
+            rhs_cols: rhs_cols.max(1),
+        }
+    }
+
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The matrix to factor (column-major); overwritten by the factors.
+    pub fn matrix_mut(&mut self) -> MatMut<'_, f64> {
+        self.a.as_mut()
+    }
+
+    /// Factors the matrix in place and returns its pivot magnitudes.
+    pub fn factor(&mut self) -> Pivots {
+        let n = self.n;
+        if n == 0 {
+            return Pivots { max: 1.0, min: 1.0 };
+        }
+        let _ = factor::lu_in_place(
+            self.a.as_mut(),
+            &mut self.row_fwd,
+            &mut self.row_inv,
+            &mut self.col_fwd,
+            &mut self.col_inv,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
+        let mut max = 0.0_f64;
+        let mut min = f64::INFINITY;
+        for k in 0..n {
+            let u = self.a[(k, k)].abs();
+            if u.is_nan() {
+                return Pivots { max, min: 0.0 };
+            }
+            max = max.max(u);
+            min = min.min(u);
+        }
+        Pivots { max, min }
+    }
+
+    /// Solves $A X = B$ in place with the last factorization; `rhs` is `n × k`,
+    /// `k ≤ rhs_cols`.
+    pub fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) {
+        if self.n == 0 {
+            return;
+        }
+        debug_assert!(rhs.ncols() <= self.rhs_cols);
+        let row = PermRef::new_checked(&self.row_fwd, &self.row_inv, self.n);
+        let col = PermRef::new_checked(&self.col_fwd, &self.col_inv, self.n);
+        solve::solve_in_place(
+            self.a.as_ref(),
+            self.a.as_ref(),
+            row,
+            col,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+    }
+
+    /// Solves $A x = b$ for one vector in place.
+    pub fn solve_vec(&mut self, b: &mut [f64]) {
+        let n = self.n;
+        self.solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
+    }
+}

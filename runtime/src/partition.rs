@@ -1,0 +1,377 @@
+//! Generalized coordinate partitioning (math-spec §6, Algorithm P) and its condition
+//! monitor.
+//!
+//! Input: a configuration $(q, t)$ (consistent or not) and the Jacobian
+//! $J = [C_q; G]$ evaluated there. Output: a [`Partition`] of the coordinates into
+//! - $\beta$ ($m_h$ dependent coordinates): the pivot columns of Gaussian elimination
+//!   with complete pivoting on $C_q$;
+//! - $\eta$ ($m_{nh}$ independent coordinates with dependent velocities): the pivot
+//!   columns of complete pivoting on the Schur complement
+//!   $\hat G = G_p - G_\beta C_\beta^{-1} C_p$;
+//! - $\gamma$ (the rest): independent coordinates and velocities.
+//!
+//! Then $J_d = \begin{bmatrix}C_\beta & C_\eta\\ G_\beta & G_\eta\end{bmatrix}$ is
+//! non-singular with $|\det J_d| = |\det C_\beta|\,|\det \hat G_\eta|$.
+//!
+//! A pivot below `pivot_tolerance` × (largest entry) means redundant or singular
+//! constraints: the rows left without a pivot are reported by name.
+//!
+//! **Condition monitor.** The partition stores, per block, the ratio
+//! $\rho = \min_k |u_{kk}| / \max_{ij} |a_{ij}|$ of the smallest pivot of $C_\beta$
+//! (resp. $\hat G_\eta$) to the largest entry of $C_q$ (resp. $\hat G$). The same ratio
+//! recomputed later ([`Partition::condition`]) falls towards 0 as the chosen dependent
+//! block approaches singularity while a better choice exists; the caller re-partitions
+//! when it drops below `deterioration` × its value at partition time.
+
+use crate::linalg::elimination::{Elimination, Tier};
+use crate::workspace::{check_state, EvalError, Workspace};
+use crate::{Info, Mechanism};
+
+/// Tuning of Algorithm P.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PartitionParams {
+    /// Relative pivot threshold $\varepsilon_{piv}$ below which constraints are
+    /// declared redundant or singular.
+    pub pivot_tolerance: f64,
+    /// Re-partition when a pivot ratio falls below this fraction of its value at
+    /// partition time.
+    pub deterioration: f64,
+}
+
+impl Default for PartitionParams {
+    fn default() -> Self {
+        Self {
+            pivot_tolerance: 1e-9,
+            deterioration: 1e-3,
+        }
+    }
+}
+
+/// Pivot ratios of the dependent blocks (see the module docs); 1 for an empty block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Condition {
+    /// Ratio for $C_\beta$ against $C_q$.
+    pub holonomic: f64,
+    /// Ratio for $\hat G_\eta$ against $\hat G$.
+    pub nonholonomic: f64,
+}
+
+/// Role of a coordinate in a partition.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// In $\beta$: dependent coordinate and velocity.
+    Dependent,
+    /// In $\eta$: independent coordinate, dependent velocity.
+    DependentVelocity,
+    /// In $\gamma$: independent coordinate and velocity.
+    Independent,
+}
+
+/// Errors of Algorithm P.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PartitionError {
+    /// $C_q$ is rank deficient.
+    #[error("redundant or singular holonomic constraints at t = {t}: {constraints:?} (pivot ratio {ratio:e}, rank {rank} of {rows})")]
+    RedundantHolonomic {
+        /// Time.
+        t: f64,
+        /// The constraints left without a pivot.
+        constraints: Vec<&'static str>,
+        /// Best pivot left at the stop / largest entry (below the tolerance).
+        ratio: f64,
+        /// Numerical rank of $C_q$.
+        rank: usize,
+        /// $m_h$.
+        rows: usize,
+    },
+    /// $\hat G$ is rank deficient: non-holonomic constraints depend on the others.
+    #[error("redundant or singular non-holonomic constraints at t = {t}: {constraints:?} (pivot ratio {ratio:e})")]
+    RedundantNonholonomic {
+        /// Time.
+        t: f64,
+        /// The constraints left without a pivot.
+        constraints: Vec<&'static str>,
+        /// Best pivot left at the stop / largest entry (below the tolerance).
+        ratio: f64,
+    },
+    /// A coordinate asked to stay independent must be dependent.
+    #[error("coordinate `{coordinate}` cannot be kept independent at t = {t}: constraints {constraints:?} can only be met by moving it (or other prescribed coordinates)")]
+    PrescribedCoordinate {
+        /// Time.
+        t: f64,
+        /// The coordinate that had to become dependent.
+        coordinate: &'static str,
+        /// The constraints that force it.
+        constraints: Vec<&'static str>,
+    },
+    /// A coordinate whose velocity is prescribed must have a dependent velocity.
+    #[error("the velocity of `{coordinate}` cannot be prescribed at t = {t}: constraints {constraints:?} determine it (too many or inconsistent prescribed velocities)")]
+    PrescribedVelocity {
+        /// Time.
+        t: f64,
+        /// The coordinate whose velocity had to become dependent.
+        coordinate: &'static str,
+        /// The constraints that determine it.
+        constraints: Vec<&'static str>,
+    },
+    /// Evaluation failed.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
+/// Coordinates to keep independent if possible (indices into `q`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Preferences<'a> {
+    /// Coordinates that must not be in $\beta$.
+    pub coordinates: &'a [usize],
+    /// Coordinates whose velocity must be independent (in $\gamma$).
+    pub velocities: &'a [usize],
+}
+
+/// A partition $q \equiv [\beta; \eta; \gamma]$ (Algorithm P).
+#[derive(Clone, Debug)]
+pub struct Partition {
+    info: &'static Info,
+    pub(crate) dependent: Vec<usize>,
+    pub(crate) eta: Vec<usize>,
+    pub(crate) independent: Vec<usize>,
+    pub(crate) reference: Condition,
+    pub(crate) abs_det: f64,
+    pub(crate) time: f64,
+}
+
+impl Partition {
+    /// Runs Algorithm P at $(q, t)$ with a fresh scratch (allocates; see
+    /// [`Kinematics`](crate::Kinematics) for the reusable form).
+    pub fn compute<M: Mechanism + ?Sized>(
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+        prefs: Preferences<'_>,
+        params: &PartitionParams,
+    ) -> Result<Self, PartitionError> {
+        let info = ws.info();
+        let mut elim = Elimination::new(info.nh() + info.nnh(), info.nq());
+        compute_with(&mut elim, mech, ws, t, q, prefs, params)
+    }
+
+    /// $\beta$: dependent coordinates, in pivot order.
+    #[must_use]
+    pub fn dependent(&self) -> &[usize] {
+        &self.dependent
+    }
+
+    /// $\eta$: independent coordinates with dependent velocities.
+    #[must_use]
+    pub fn dependent_velocity(&self) -> &[usize] {
+        &self.eta
+    }
+
+    /// $\gamma$: fully independent coordinates.
+    #[must_use]
+    pub fn independent(&self) -> &[usize] {
+        &self.independent
+    }
+
+    /// Names of $\beta$, $\eta$, $\gamma$.
+    #[must_use]
+    pub fn names(&self) -> [Vec<&'static str>; 3] {
+        let name = |v: &[usize]| v.iter().map(|&i| self.info.coordinates[i].name).collect();
+        [
+            name(&self.dependent),
+            name(&self.eta),
+            name(&self.independent),
+        ]
+    }
+
+    /// Role of coordinate `i`.
+    #[must_use]
+    pub fn role(&self, i: usize) -> Role {
+        if self.dependent.contains(&i) {
+            Role::Dependent
+        } else if self.eta.contains(&i) {
+            Role::DependentVelocity
+        } else {
+            Role::Independent
+        }
+    }
+
+    /// Pivot ratios at partition time.
+    #[must_use]
+    pub fn reference_condition(&self) -> Condition {
+        self.reference
+    }
+
+    /// $|\det C_\beta|$ at partition time.
+    #[must_use]
+    pub fn abs_det_dependent(&self) -> f64 {
+        self.abs_det
+    }
+
+    /// Time at which the partition was computed.
+    #[must_use]
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Recomputes the pivot ratios of this partition at $(q,t)$ with a fresh scratch
+    /// (allocates; see [`Kinematics::condition`](crate::Kinematics::condition)).
+    pub fn condition<M: Mechanism + ?Sized>(
+        &self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+    ) -> Result<Condition, EvalError> {
+        let info = ws.info();
+        let mut elim = Elimination::new(info.nh() + info.nnh(), info.nq());
+        condition_with(&mut elim, self, mech, ws, t, q)
+    }
+
+    /// Whether `now` has deteriorated below `params.deterioration` × the reference.
+    #[must_use]
+    pub fn is_deteriorated(&self, now: Condition, params: &PartitionParams) -> bool {
+        now.holonomic < params.deterioration * self.reference.holonomic
+            || now.nonholonomic < params.deterioration * self.reference.nonholonomic
+    }
+}
+
+/// Algorithm P on a reusable elimination scratch.
+pub(crate) fn compute_with<M: Mechanism + ?Sized>(
+    elim: &mut Elimination,
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    prefs: Preferences<'_>,
+    params: &PartitionParams,
+) -> Result<Partition, PartitionError> {
+    let info = ws.info();
+    let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+    check_state(info, t, q, None)?;
+    ws.eval_jacobian(mech, t, q)?;
+    elim.load(&ws.jacobian);
+    let names = |rows: &[usize]| -> Vec<&'static str> {
+        rows.iter()
+            .map(|&r| {
+                if r < mh {
+                    info.holonomic[r].name
+                } else {
+                    info.nonholonomic[r - mh].name
+                }
+            })
+            .collect()
+    };
+    // Step 1: β from C_q, keeping prescribed coordinates (and coordinates with
+    // prescribed velocities) out of it when possible.
+    for &i in prefs.coordinates.iter().chain(prefs.velocities) {
+        elim.tier[i] = Tier::Allowed;
+    }
+    let ph1 = elim.phase(0, mh, mh, params.pivot_tolerance);
+    if ph1.rank < mh {
+        return Err(PartitionError::RedundantHolonomic {
+            t,
+            constraints: names(&elim.rows[ph1.rank..mh]),
+            ratio: if ph1.scale > 0.0 {
+                ph1.rejected / ph1.scale
+            } else {
+                0.0
+            },
+            rank: ph1.rank,
+            rows: mh,
+        });
+    }
+    if let Some(k) = ph1.first_allowed {
+        let col = elim.cols[k];
+        let coordinate = info.coordinates[col].name;
+        let constraints = names(&elim.rows[k..mh]);
+        return Err(if prefs.coordinates.contains(&col) {
+            PartitionError::PrescribedCoordinate {
+                t,
+                coordinate,
+                constraints,
+            }
+        } else {
+            PartitionError::PrescribedVelocity {
+                t,
+                coordinate,
+                constraints,
+            }
+        });
+    }
+    // Step 2: η among the remaining columns, from the Schur complement Ĝ that the
+    // first phase left in the non-holonomic rows.
+    elim.tier.fill(Tier::Preferred);
+    for &i in prefs.velocities {
+        elim.tier[i] = Tier::Allowed;
+    }
+    let ph2 = elim.phase(mh, m, m - mh, params.pivot_tolerance);
+    if ph2.rank < m - mh {
+        return Err(PartitionError::RedundantNonholonomic {
+            t,
+            constraints: names(&elim.rows[mh + ph2.rank..m]),
+            ratio: if ph2.scale > 0.0 {
+                ph2.rejected / ph2.scale
+            } else {
+                0.0
+            },
+        });
+    }
+    if let Some(k) = ph2.first_allowed {
+        return Err(PartitionError::PrescribedVelocity {
+            t,
+            coordinate: info.coordinates[elim.cols[k]].name,
+            constraints: names(&elim.rows[k..m]),
+        });
+    }
+    Ok(Partition {
+        info,
+        dependent: elim.cols[..mh].to_vec(),
+        eta: elim.cols[mh..m].to_vec(),
+        independent: elim.cols[m..n].to_vec(),
+        reference: Condition {
+            holonomic: ph1.ratio(mh),
+            nonholonomic: ph2.ratio(m - mh),
+        },
+        abs_det: ph1.abs_det,
+        time: t,
+    })
+}
+
+/// The condition monitor on a reusable elimination scratch.
+pub(crate) fn condition_with<M: Mechanism + ?Sized>(
+    elim: &mut Elimination,
+    partition: &Partition,
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+) -> Result<Condition, EvalError> {
+    let info = ws.info();
+    let (mh, m) = (info.nh(), info.nh() + info.nnh());
+    check_state(info, t, q, None)?;
+    ws.eval_jacobian(mech, t, q)?;
+    elim.load(&ws.jacobian);
+    elim.tier.fill(Tier::Forbidden);
+    for &i in &partition.dependent {
+        elim.tier[i] = Tier::Preferred;
+    }
+    let ph1 = elim.phase(0, mh, mh, 0.0);
+    let holonomic = ph1.ratio(mh);
+    if ph1.rank < mh {
+        return Ok(Condition {
+            holonomic,
+            nonholonomic: 0.0,
+        });
+    }
+    elim.tier.fill(Tier::Forbidden);
+    for &i in &partition.eta {
+        elim.tier[i] = Tier::Preferred;
+    }
+    let ph2 = elim.phase(mh, m, m - mh, 0.0);
+    Ok(Condition {
+        holonomic,
+        nonholonomic: ph2.ratio(m - mh),
+    })
+}

@@ -1,0 +1,452 @@
+//! Per-model buffers and checked evaluation of the generated functions.
+//!
+//! Input: a [`Mechanism`] and its [`Info`]. Output: the values of $M$, $Q$, $C$,
+//! $C_q$, $C_t$, $G$, $g$ and $\gamma = [\gamma_h; \gamma_{nh}]$ in buffers owned by
+//! [`Workspace`], with $J = [C_q; G]$ also scattered into a dense row-major
+//! $m \times n$ array. Every evaluation checks that its output is finite and reports the
+//! first offending entry as an [`EvalError`].
+//!
+//! Invariant: all buffers are allocated in [`Workspace::new`]; evaluations never
+//! allocate. A workspace may be shared by [`Kinematics`](crate::Kinematics) and
+//! [`Dynamics`](crate::Dynamics) of the same model.
+
+use std::fmt;
+
+use crate::{Info, Mechanism, Pattern};
+
+/// A quantity computed by the model or by the runtime, named in error messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Input coordinates `q`.
+    Coordinates,
+    /// Input velocities `q̇`.
+    Velocities,
+    /// Input time `t`.
+    Time,
+    /// The mass matrix `M`.
+    MassMatrix,
+    /// The generalized forces `Q`.
+    Forces,
+    /// The holonomic constraints `C`.
+    Constraints,
+    /// The holonomic Jacobian `C_q`.
+    HolonomicJacobian,
+    /// The time partial `C_t`.
+    HolonomicRate,
+    /// `γ_h`.
+    HolonomicGamma,
+    /// The non-holonomic matrix `G`.
+    NonholonomicMatrix,
+    /// The non-holonomic bias `g`.
+    NonholonomicBias,
+    /// `γ_nh`.
+    NonholonomicGamma,
+    /// Computed accelerations `q̈`.
+    Accelerations,
+    /// Computed multipliers `λ`.
+    Multipliers,
+}
+
+impl fmt::Display for Quantity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Coordinates => "coordinates `q`",
+            Self::Velocities => "velocities `q'`",
+            Self::Time => "time `t`",
+            Self::MassMatrix => "mass matrix `M`",
+            Self::Forces => "generalized forces `Q`",
+            Self::Constraints => "holonomic constraints `C`",
+            Self::HolonomicJacobian => "holonomic Jacobian `C_q`",
+            Self::HolonomicRate => "time partial `C_t`",
+            Self::HolonomicGamma => "holonomic acceleration term `gamma_h`",
+            Self::NonholonomicMatrix => "non-holonomic matrix `G`",
+            Self::NonholonomicBias => "non-holonomic bias `g`",
+            Self::NonholonomicGamma => "non-holonomic acceleration term `gamma_nh`",
+            Self::Accelerations => "accelerations `q''`",
+            Self::Multipliers => "multipliers `lambda`",
+        })
+    }
+}
+
+/// Errors of evaluation and of model description.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    /// A value is NaN or infinite. `row`/`col` locate it (`col` only for matrices).
+    #[error("non-finite {quantity} at t = {t}: entry ({row}{}) is {value}", col.map(|c| format!(", {c}")).unwrap_or_default())]
+    NonFinite {
+        /// The offending quantity.
+        quantity: Quantity,
+        /// Time of the evaluation.
+        t: f64,
+        /// Row (or vector index).
+        row: usize,
+        /// Column, for matrices.
+        col: Option<usize>,
+        /// The value found.
+        value: f64,
+    },
+    /// A buffer passed by the caller has the wrong length.
+    #[error("{quantity} has length {found}, expected {expected}")]
+    Length {
+        /// Which buffer.
+        quantity: Quantity,
+        /// Its length.
+        found: usize,
+        /// The length the model requires.
+        expected: usize,
+    },
+    /// A sparsity pattern of the model is malformed.
+    #[error("pattern of the {quantity} of model `{model}`: entry #{entry} {reason}")]
+    Pattern {
+        /// The model's name.
+        model: &'static str,
+        /// Which pattern.
+        quantity: Quantity,
+        /// Index of the bad entry.
+        entry: usize,
+        /// What is wrong with it.
+        reason: PatternDefect,
+    },
+}
+
+/// What is wrong with a pattern entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatternDefect {
+    /// Row or column out of range.
+    OutOfRange,
+    /// Not sorted by row then column, or duplicated.
+    Unsorted,
+}
+
+impl fmt::Display for PatternDefect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::OutOfRange => "is out of range",
+            Self::Unsorted => "is not sorted by row then column, or is duplicated",
+        })
+    }
+}
+
+/// Checks that every entry of `x` is finite.
+pub(crate) fn check_finite(quantity: Quantity, t: f64, x: &[f64]) -> Result<(), EvalError> {
+    match x.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(row) => Err(EvalError::NonFinite {
+            quantity,
+            t,
+            row,
+            col: None,
+            value: x[row],
+        }),
+    }
+}
+
+/// Checks that every pattern value is finite.
+fn check_finite_pattern(
+    quantity: Quantity,
+    t: f64,
+    pattern: Pattern,
+    x: &[f64],
+) -> Result<(), EvalError> {
+    match x.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(EvalError::NonFinite {
+            quantity,
+            t,
+            row: pattern[k].0 as usize,
+            col: Some(pattern[k].1 as usize),
+            value: x[k],
+        }),
+    }
+}
+
+/// Checks a caller buffer length.
+pub(crate) fn check_len(quantity: Quantity, x: &[f64], expected: usize) -> Result<(), EvalError> {
+    if x.len() == expected {
+        Ok(())
+    } else {
+        Err(EvalError::Length {
+            quantity,
+            found: x.len(),
+            expected,
+        })
+    }
+}
+
+/// Checks the input time, coordinates and (optionally) velocities of an evaluation.
+pub(crate) fn check_state(
+    info: &Info,
+    t: f64,
+    q: &[f64],
+    qd: Option<&[f64]>,
+) -> Result<(), EvalError> {
+    if !t.is_finite() {
+        return Err(EvalError::NonFinite {
+            quantity: Quantity::Time,
+            t,
+            row: 0,
+            col: None,
+            value: t,
+        });
+    }
+    check_len(Quantity::Coordinates, q, info.nq())?;
+    check_finite(Quantity::Coordinates, t, q)?;
+    if let Some(qd) = qd {
+        check_len(Quantity::Velocities, qd, info.nq())?;
+        check_finite(Quantity::Velocities, t, qd)?;
+    }
+    Ok(())
+}
+
+fn check_pattern(
+    model: &'static str,
+    quantity: Quantity,
+    pattern: Pattern,
+    rows: usize,
+    cols: usize,
+) -> Result<(), EvalError> {
+    let bad = |entry, reason| EvalError::Pattern {
+        model,
+        quantity,
+        entry,
+        reason,
+    };
+    for (k, &(r, c)) in pattern.iter().enumerate() {
+        if r as usize >= rows || c as usize >= cols {
+            return Err(bad(k, PatternDefect::OutOfRange));
+        }
+        if k > 0 && pattern[k - 1] >= (r, c) {
+            return Err(bad(k, PatternDefect::Unsorted));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the pattern `values` into the dense row-major `rows × ncols` array `out`
+/// (zeroing it first).
+pub fn scatter_row_major(pattern: Pattern, values: &[f64], ncols: usize, out: &mut [f64]) {
+    out.fill(0.0);
+    for (&(r, c), &v) in pattern.iter().zip(values) {
+        out[r as usize * ncols + c as usize] = v;
+    }
+}
+
+/// Buffers for one model, allocated once.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    info: &'static Info,
+    pub(crate) mass_values: Vec<f64>,
+    pub(crate) cq_values: Vec<f64>,
+    pub(crate) g_values: Vec<f64>,
+    /// Dense row-major `m × n` array of $J = [C_q; G]$.
+    pub(crate) jacobian: Vec<f64>,
+    pub(crate) c: Vec<f64>,
+    pub(crate) ct: Vec<f64>,
+    pub(crate) bias: Vec<f64>,
+    /// $[\gamma_h; \gamma_{nh}]$ (length $m$).
+    pub(crate) gamma: Vec<f64>,
+    pub(crate) forces: Vec<f64>,
+}
+
+impl Workspace {
+    /// Allocates the buffers of the model described by `info`, after checking its
+    /// patterns.
+    pub fn new(info: &'static Info) -> Result<Self, EvalError> {
+        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        check_pattern(info.name, Quantity::MassMatrix, info.mass_pattern, n, n)?;
+        check_pattern(
+            info.name,
+            Quantity::HolonomicJacobian,
+            info.holonomic_pattern,
+            mh,
+            n,
+        )?;
+        check_pattern(
+            info.name,
+            Quantity::NonholonomicMatrix,
+            info.nonholonomic_pattern,
+            mnh,
+            n,
+        )?;
+        Ok(Self {
+            info,
+            mass_values: vec![0.0; info.mass_pattern.len()],
+            cq_values: vec![0.0; info.holonomic_pattern.len()],
+            g_values: vec![0.0; info.nonholonomic_pattern.len()],
+            jacobian: vec![0.0; (mh + mnh) * n],
+            c: vec![0.0; mh],
+            ct: vec![0.0; mh],
+            bias: vec![0.0; mnh],
+            gamma: vec![0.0; mh + mnh],
+            forces: vec![0.0; n],
+        })
+    }
+
+    /// The model description.
+    #[must_use]
+    pub fn info(&self) -> &'static Info {
+        self.info
+    }
+
+    /// Evaluates the pattern values of $C_q$ and $G$ and scatters them into the dense
+    /// $J$ ([`Workspace::jacobian`]).
+    pub fn eval_jacobian<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        self.eval_jacobian_values(mech, t, q)?;
+        let n = self.info.nq();
+        let split = self.info.nh() * n;
+        let (h, nh) = self.jacobian.split_at_mut(split);
+        scatter_row_major(self.info.holonomic_pattern, &self.cq_values, n, h);
+        scatter_row_major(self.info.nonholonomic_pattern, &self.g_values, n, nh);
+        Ok(())
+    }
+
+    /// Evaluates the pattern values of $C_q$ and $G$ only.
+    pub fn eval_jacobian_values<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        let info = self.info;
+        if info.nh() > 0 {
+            mech.holonomic_jacobian(t, q, &mut self.cq_values);
+            check_finite_pattern(
+                Quantity::HolonomicJacobian,
+                t,
+                info.holonomic_pattern,
+                &self.cq_values,
+            )?;
+        }
+        if info.nnh() > 0 {
+            mech.nonholonomic_matrix(t, q, &mut self.g_values);
+            check_finite_pattern(
+                Quantity::NonholonomicMatrix,
+                t,
+                info.nonholonomic_pattern,
+                &self.g_values,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates $C(q,t)$.
+    pub fn eval_constraints<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        if self.info.nh() > 0 {
+            mech.holonomic(t, q, &mut self.c);
+            check_finite(Quantity::Constraints, t, &self.c)?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates $C_t$ and $g$.
+    pub fn eval_rates<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        let info = self.info;
+        if info.nh() > 0 && info.time.holonomic {
+            mech.holonomic_rate(t, q, &mut self.ct);
+            check_finite(Quantity::HolonomicRate, t, &self.ct)?;
+        } else {
+            self.ct.fill(0.0);
+        }
+        if info.nnh() > 0 && !info.nonholonomic_homogeneous {
+            mech.nonholonomic_bias(t, q, &mut self.bias);
+            check_finite(Quantity::NonholonomicBias, t, &self.bias)?;
+        } else {
+            self.bias.fill(0.0);
+        }
+        Ok(())
+    }
+
+    /// Evaluates $\gamma = [\gamma_h; \gamma_{nh}]$.
+    pub fn eval_gamma<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<(), EvalError> {
+        let mh = self.info.nh();
+        let (h, nh) = self.gamma.split_at_mut(mh);
+        if mh > 0 {
+            mech.holonomic_gamma(t, q, qd, h);
+            check_finite(Quantity::HolonomicGamma, t, h)?;
+        }
+        if !nh.is_empty() {
+            mech.nonholonomic_gamma(t, q, qd, nh);
+            check_finite(Quantity::NonholonomicGamma, t, nh).map_err(|e| match e {
+                EvalError::NonFinite {
+                    quantity,
+                    t,
+                    row,
+                    col,
+                    value,
+                } => EvalError::NonFinite {
+                    quantity,
+                    t,
+                    row: row + mh,
+                    col,
+                    value,
+                },
+                other => other,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates the pattern values of $M$ and the forces $Q$.
+    pub fn eval_mass_and_forces<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<(), EvalError> {
+        mech.mass_matrix(t, q, &mut self.mass_values);
+        check_finite_pattern(
+            Quantity::MassMatrix,
+            t,
+            self.info.mass_pattern,
+            &self.mass_values,
+        )?;
+        mech.forces(t, q, qd, &mut self.forces);
+        check_finite(Quantity::Forces, t, &self.forces)
+    }
+
+    /// The dense row-major $J = [C_q; G]$ of the last [`Workspace::eval_jacobian`].
+    #[must_use]
+    pub fn jacobian(&self) -> &[f64] {
+        &self.jacobian
+    }
+
+    /// $C$ of the last [`Workspace::eval_constraints`].
+    #[must_use]
+    pub fn constraints(&self) -> &[f64] {
+        &self.c
+    }
+
+    /// $[\gamma_h; \gamma_{nh}]$ of the last [`Workspace::eval_gamma`].
+    #[must_use]
+    pub fn gamma(&self) -> &[f64] {
+        &self.gamma
+    }
+
+    /// $Q$ of the last [`Workspace::eval_mass_and_forces`].
+    #[must_use]
+    pub fn forces(&self) -> &[f64] {
+        &self.forces
+    }
+}

@@ -1,0 +1,327 @@
+//! The Cartesian pendulum: singular partition, redundant constraints, Newton failure,
+//! assembly errors and non-finite input.
+
+mod common;
+
+use common::Pendulum;
+use pfaff::{
+    AssemblyError, Dynamics, DynamicsParams, EvalError, Kinematics, KinematicsError,
+    KinematicsParams, LinearSolver, Mechanism, PartitionError, Prescription, Quantity, SolverPath,
+    Workspace,
+};
+
+#[test]
+fn hanging_pendulum_forces_repartition_to_y() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let q0 = [1.2_f64.sin(), -1.2_f64.cos()];
+    let p = kin.repartition(&mech, &mut ws, 0.0, &q0).unwrap();
+    assert_eq!(p.names()[0], ["x"]);
+    let reference = p.reference_condition();
+    assert!((reference.holonomic - 1.0).abs() < 1e-15);
+    // Swing down to x = 0: C_β = 2x vanishes.
+    let mut q = [0.3, -0.9];
+    kin.position(&mech, &mut ws, 0.0, &mut q).unwrap(); // moves x (y fixed)
+    assert!((q[0] * q[0] + q[1] * q[1] - 1.0).abs() < 1e-14);
+    assert!(!kin.monitor(&mech, &mut ws, 0.0, &q).unwrap());
+    let hanging = [0.0, -1.0];
+    let now = kin.condition(&mech, &mut ws, 0.0, &hanging).unwrap();
+    assert_eq!(now.holonomic, 0.0);
+    assert!(kin.monitor(&mech, &mut ws, 0.0, &hanging).unwrap());
+    assert_eq!(kin.repartitions(), 1);
+    assert_eq!(kin.partition().unwrap().names()[0], ["y"]);
+    // K1 with x fixed near the bottom now works.
+    let mut q = [0.01, -0.98];
+    let stats = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap();
+    assert!(
+        (q[1] + (1.0 - 0.0001_f64).sqrt()).abs() < 1e-14,
+        "{stats:?}"
+    );
+}
+
+#[test]
+fn singular_dependent_block_during_newton_is_typed() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    kin.repartition(&mech, &mut ws, 0.0, &[0.9, -0.4]).unwrap();
+    let mut q = [0.0, -0.5];
+    let err = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap_err();
+    assert!(
+        matches!(err, KinematicsError::SingularDependent { iteration: 1, .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn newton_failure_names_the_violated_constraint() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    kin.repartition(&mech, &mut ws, 0.0, &[0.1, -0.99]).unwrap(); // β = {y}
+    let mut q = [1.5, -0.5]; // |x| > l: no y satisfies the rod
+    let err = kin.position(&mech, &mut ws, 0.25, &mut q).unwrap_err();
+    println!("{err}");
+    match err {
+        KinematicsError::NewtonFailed {
+            t,
+            iterations,
+            residual,
+            violated,
+        } => {
+            assert_eq!(t, 0.25);
+            assert_eq!(iterations, 25);
+            assert!(residual > 1.0);
+            assert_eq!(violated, ["rod"]);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    // Assembly from an impossible prescription reports the same failure.
+    let (mut q, mut qd) = ([0.5, -0.5], [0.0; 2]);
+    let err = kin
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription {
+                coordinates: &[("x", 1.5)],
+                velocities: &[],
+            },
+        )
+        .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        AssemblyError::Kinematics(KinematicsError::NewtonFailed { .. })
+    ));
+}
+
+#[test]
+fn assembly_errors_are_clear() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let (mut q, mut qd) = ([0.5, -0.5], [0.0; 2]);
+    let mut run = |p: Prescription<'_>| {
+        kin.assemble(&mech, &mut ws, 0.0, &mut q, &mut qd, &p)
+            .unwrap_err()
+    };
+    let err = run(Prescription {
+        coordinates: &[("x", 0.6), ("y", -0.8)],
+        velocities: &[],
+    });
+    println!("{err}");
+    assert!(matches!(
+        err,
+        AssemblyError::Partition(PartitionError::PrescribedCoordinate { .. })
+    ));
+    let err = run(Prescription {
+        coordinates: &[],
+        velocities: &[("x", 1.0), ("y", 1.0)],
+    });
+    println!("{err}");
+    assert!(matches!(
+        err,
+        AssemblyError::Partition(PartitionError::PrescribedVelocity { .. })
+    ));
+    let err = run(Prescription {
+        coordinates: &[("theta", 0.6)],
+        velocities: &[],
+    });
+    println!("{err}");
+    assert!(matches!(err, AssemblyError::UnknownCoordinate { .. }));
+    // A valid one: x = 0.6, x' = 0.8 on the lower branch.
+    let (mut q, mut qd) = ([0.5, -0.5], [0.0; 2]);
+    kin.assemble(
+        &mech,
+        &mut ws,
+        0.0,
+        &mut q,
+        &mut qd,
+        &Prescription {
+            coordinates: &[("x", 0.6)],
+            velocities: &[("x", 0.8)],
+        },
+    )
+    .unwrap();
+    assert!((q[1] + 0.8).abs() < 1e-14 && (qd[1] - 0.6).abs() < 1e-14);
+}
+
+#[test]
+fn duplicated_constraint_gives_minimum_norm_multipliers() {
+    let single = Pendulum::new(false);
+    let dup = Pendulum::new(true);
+    let (q, qd) = ([0.6, -0.8], [0.8 * 1.5, 0.6 * 1.5]);
+    let mut ws1 = Workspace::new(single.info()).unwrap();
+    let mut d1 = Dynamics::new(single.info(), DynamicsParams::default()).unwrap();
+    let (mut a1, mut l1) = ([0.0; 2], [0.0; 1]);
+    d1.accelerations(&single, &mut ws1, 0.0, &q, &qd, &mut a1, &mut l1)
+        .unwrap();
+    for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let mut ws = Workspace::new(dup.info()).unwrap();
+        let params = DynamicsParams {
+            solver,
+            ..Default::default()
+        };
+        let mut d = Dynamics::new(dup.info(), params).unwrap();
+        let (mut a, mut l) = ([0.0; 2], [0.0; 2]);
+        let stats = d
+            .accelerations(&dup, &mut ws, 0.0, &q, &qd, &mut a, &mut l)
+            .unwrap();
+        let names: Vec<_> = d.redundant_constraints().collect();
+        println!("{solver:?}: {stats:?}, redundant {names:?}, lambda {l:?} (single {l1:?})");
+        assert_eq!(stats.path, SolverPath::Redundant);
+        assert_eq!(stats.rank, 1);
+        assert_eq!(names.len(), 1);
+        assert!(names[0] == "rod" || names[0] == "rod_copy");
+        assert!((a[0] - a1[0]).abs() < 1e-12 && (a[1] - a1[1]).abs() < 1e-12);
+        // Equal split: the least-norm λ with λ₁ + λ₂ = λ_single.
+        assert!((l[0] - l[1]).abs() < 1e-12);
+        assert!((l[0] + l[1] - l1[0]).abs() < 1e-12);
+    }
+    // Algorithm P refuses the duplicated rows and names them.
+    let mut ws = Workspace::new(dup.info()).unwrap();
+    let err = pfaff::Partition::compute(
+        &dup,
+        &mut ws,
+        0.0,
+        &q,
+        Default::default(),
+        &Default::default(),
+    )
+    .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        PartitionError::RedundantHolonomic { rank: 1, rows: 2, ref constraints, .. } if constraints.len() == 1
+    ));
+}
+
+#[test]
+fn inconsistent_redundant_constraints_are_reported() {
+    // Both rows of the duplicated pendulum, but a γ that contradicts the copy.
+    struct Bad(Pendulum);
+    impl Mechanism for Bad {
+        fn info(&self) -> &'static pfaff::Info {
+            self.0.info()
+        }
+        fn parameter(&self, i: usize) -> f64 {
+            self.0.parameter(i)
+        }
+        fn set_parameter(&mut self, i: usize, v: f64) {
+            self.0.set_parameter(i, v);
+        }
+        fn mass_matrix(&self, t: f64, q: &[f64], out: &mut [f64]) {
+            self.0.mass_matrix(t, q, out);
+        }
+        fn forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+            self.0.forces(t, q, qd, out);
+        }
+        fn holonomic_jacobian(&self, t: f64, q: &[f64], out: &mut [f64]) {
+            self.0.holonomic_jacobian(t, q, out);
+        }
+        fn holonomic_gamma(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+            self.0.holonomic_gamma(t, q, qd, out);
+            out[1] += 1.0;
+        }
+        fn kinetic_energy(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+            self.0.kinetic_energy(t, q, qd)
+        }
+    }
+    let mech = Bad(Pendulum::new(true));
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut d = Dynamics::new(mech.info(), DynamicsParams::default()).unwrap();
+    let (mut a, mut l) = ([0.0; 2], [0.0; 2]);
+    let err = d
+        .accelerations(&mech, &mut ws, 0.0, &[0.6, -0.8], &[0.0; 2], &mut a, &mut l)
+        .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::InconsistentRedundant { .. }
+    ));
+}
+
+#[test]
+fn non_finite_inputs_and_outputs_are_reported() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut d = Dynamics::new(mech.info(), DynamicsParams::default()).unwrap();
+    let (mut a, mut l) = ([0.0; 2], [0.0; 1]);
+    let err = d
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[f64::NAN, -1.0],
+            &[0.0; 2],
+            &mut a,
+            &mut l,
+        )
+        .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::Eval(EvalError::NonFinite {
+            quantity: Quantity::Coordinates,
+            row: 0,
+            ..
+        })
+    ));
+    let err = d
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[0.6, -0.8],
+            &[f64::INFINITY, 0.0],
+            &mut a,
+            &mut l,
+        )
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::Eval(EvalError::NonFinite {
+            quantity: Quantity::Velocities,
+            ..
+        })
+    ));
+    // At the origin C_q = 0: the augmented matrix is singular. At rest the zero row is
+    // consistent (rank 0, λ = 0, free fall); in motion it contradicts γ. Never a NaN.
+    let stats = d
+        .accelerations(&mech, &mut ws, 0.0, &[0.0, 0.0], &[0.0; 2], &mut a, &mut l)
+        .unwrap();
+    assert_eq!((stats.path, stats.rank), (SolverPath::Redundant, 0));
+    assert_eq!(l, [0.0]);
+    assert!(a[0].abs() < 1e-15 && (a[1] + common::G).abs() < 1e-14);
+    let err = d
+        .accelerations(
+            &mech,
+            &mut ws,
+            0.0,
+            &[0.0, 0.0],
+            &[1.0, 0.0],
+            &mut a,
+            &mut l,
+        )
+        .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        pfaff::DynamicsError::InconsistentRedundant { .. }
+    ));
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let err = kin
+        .repartition(&mech, &mut ws, 0.0, &[0.0, 0.0])
+        .unwrap_err();
+    println!("{err}");
+    assert!(matches!(
+        err,
+        PartitionError::RedundantHolonomic { rank: 0, .. }
+    ));
+    let err: pfaff::Error = err.into();
+    assert!(err.to_string().contains("rod"));
+}

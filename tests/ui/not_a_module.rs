@@ -1,0 +1,3 @@
+#[pfaff::mechanism]
+fn pendulum() {}
+fn main() {}
