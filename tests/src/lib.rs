@@ -3,4 +3,6 @@
 //! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
 #[cfg(test)]
+mod accuracy;
+#[cfg(test)]
 mod ui;
