@@ -14,6 +14,9 @@
 //! [`expand`] is what the proc macro calls; [`analyze`] exposes the intermediate
 //! results to tests, snapshots and benchmarks.
 
+// Index loops mirror the mathematics (M_ij, rows r and columns j of C_q).
+#![allow(clippy::needless_range_loop)]
+
 pub mod ctxt;
 pub mod derive;
 pub mod emit;

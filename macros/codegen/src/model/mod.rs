@@ -94,10 +94,10 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         let s = name.to_string();
         if kw::RESERVED.contains(&s.as_str()) {
             cx.error_spanned_by(name, format!("`{s}` is reserved and cannot be declared"));
-        } else if seen.contains_key(&s) {
-            cx.error_spanned_by(name, format!("duplicate name `{s}`: it is declared above"));
+        } else if let std::collections::hash_map::Entry::Vacant(slot) = seen.entry(s.clone()) {
+            slot.insert(name.clone());
         } else {
-            seen.insert(s, name.clone());
+            cx.error_spanned_by(name, format!("duplicate name `{s}`: it is declared above"));
         }
     };
     let mut pending_forces = Vec::new();

@@ -25,6 +25,7 @@ pub struct Mechanism {
 
 /// A declaration inside the module.
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // built once per expansion, never stored in bulk
 pub enum Item {
     /// `const m: f64 = 1.0;`
     Param {
