@@ -1,5 +1,8 @@
-//! The Butcher tableau of DOP853 (Hairer, Nørsett & Wanner; Dormand & Prince 1980),
-//! copied digit for digit from Hairer's published `dop853.f`.
+//! The Butcher tableau of DOP853 (Hairer, Nørsett & Wanner; Dormand & Prince 1980) with
+//! the digits of Hairer's published `dop853.f`, transcribed by script from SciPy's copy
+//! (`scipy/integrate/_ivp/dop853_coefficients.py`). Checked by the row sums
+//! $\sum_j a_{ij} = c_i$, the quadrature conditions $\sum_j b_j c_j^q = 1/(q+1)$ for
+//! $q \le 7$, and the measured local orders of step and dense output in the tests.
 //!
 //! Input: none. Output: constants. Invariants: stage indices are 0-based; only the
 //! non-zero coefficients are listed; stage 13 (index 12) is the FSAL evaluation

@@ -13,7 +13,7 @@
 //! local extrapolation (the corrected value has order $k+1$ while the error is
 //! controlled at order $k$), written with the modified divided differences $\phi_i$
 //! and the step history $\psi_i = x_{n+1} - x_{n+1-i}$, $\alpha_i$, $\beta_i$,
-//! $\sigma_i$ and $g_i$ (see [`step`](self) for the port, block by block).
+//! $\sigma_i$ and $g_i$ (the private module `step` holds the port, block by block).
 //!
 //! # Tolerance semantics
 //! With $\varepsilon = \max(\text{rtol}, \max_i\text{atol}_i)$ and weights
