@@ -1,0 +1,76 @@
+//! Snapshots of the generator's output for every built-in model (`models/src/*.rs`):
+//! the derived quantities as formulas (`<model>__symbolic`) and the emitted Rust,
+//! formatted by prettyplease (`<model>__emit`). A change to the generator shows up
+//! here as a readable diff; review it with `cargo insta review`.
+
+use std::path::PathBuf;
+
+use proc_macro2::TokenStream;
+use quote::ToTokens;
+
+/// The `#[pfaff::mechanism]` modules of a source file, with the attribute removed.
+fn mechanisms(src: &str) -> Vec<(String, TokenStream)> {
+    let file = syn::parse_file(src).expect("model files parse");
+    file.items
+        .into_iter()
+        .filter_map(|item| match item {
+            syn::Item::Mod(mut m) => {
+                let at = m.attrs.iter().position(|a| {
+                    a.path()
+                        .segments
+                        .last()
+                        .is_some_and(|s| s.ident == "mechanism")
+                })?;
+                m.attrs.remove(at);
+                Some((m.ident.to_string(), m.into_token_stream()))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+fn model_sources() -> Vec<(String, TokenStream)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models/src");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("models/src exists")
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
+        .collect();
+    files.sort();
+    files
+        .iter()
+        .flat_map(|p| mechanisms(&std::fs::read_to_string(p).expect("readable model file")))
+        .collect()
+}
+
+fn pretty(ts: TokenStream) -> String {
+    prettyplease::unparse(&syn::parse2::<syn::File>(ts).expect("generated code parses"))
+}
+
+#[test]
+fn every_model_expands_to_the_reviewed_code() {
+    let models = model_sources();
+    assert!(
+        models.len() >= 7,
+        "the built-in models are found: {}",
+        models.len()
+    );
+    for (name, tokens) in models {
+        let analysis = pfaff_codegen::analyze(TokenStream::new(), tokens.clone())
+            .unwrap_or_else(|e| panic!("{name} has errors: {e}"));
+        insta::assert_snapshot!(format!("{name}__symbolic"), analysis.describe());
+        insta::assert_snapshot!(
+            format!("{name}__emit"),
+            pretty(pfaff_codegen::expand(TokenStream::new(), tokens))
+        );
+    }
+}
+
+#[test]
+fn expansion_is_deterministic() {
+    for (name, tokens) in model_sources() {
+        let a = pfaff_codegen::expand(TokenStream::new(), tokens.clone()).to_string();
+        let b = pfaff_codegen::expand(TokenStream::new(), tokens).to_string();
+        assert_eq!(a, b, "{name}: two expansions differ");
+    }
+}
