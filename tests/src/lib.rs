@@ -2,6 +2,8 @@
 //!
 //! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
+pub mod sources;
+
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]

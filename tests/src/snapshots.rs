@@ -3,45 +3,9 @@
 //! formatted by prettyplease (`<model>__emit`). A change to the generator shows up
 //! here as a readable diff; review it with `cargo insta review`.
 
-use std::path::PathBuf;
-
 use proc_macro2::TokenStream;
-use quote::ToTokens;
 
-/// The `#[pfaff::mechanism]` modules of a source file, with the attribute removed.
-fn mechanisms(src: &str) -> Vec<(String, TokenStream)> {
-    let file = syn::parse_file(src).expect("model files parse");
-    file.items
-        .into_iter()
-        .filter_map(|item| match item {
-            syn::Item::Mod(mut m) => {
-                let at = m.attrs.iter().position(|a| {
-                    a.path()
-                        .segments
-                        .last()
-                        .is_some_and(|s| s.ident == "mechanism")
-                })?;
-                m.attrs.remove(at);
-                Some((m.ident.to_string(), m.into_token_stream()))
-            }
-            _ => None,
-        })
-        .collect()
-}
-
-fn model_sources() -> Vec<(String, TokenStream)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models/src");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("models/src exists")
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
-        .collect();
-    files.sort();
-    files
-        .iter()
-        .flat_map(|p| mechanisms(&std::fs::read_to_string(p).expect("readable model file")))
-        .collect()
-}
+use crate::sources::model_sources;
 
 fn pretty(ts: TokenStream) -> String {
     prettyplease::unparse(&syn::parse2::<syn::File>(ts).expect("generated code parses"))
