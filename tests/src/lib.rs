@@ -5,4 +5,6 @@
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod sim;
+#[cfg(test)]
 mod ui;
