@@ -22,10 +22,17 @@ use super::trajectory::{Monitors, Run, Stats, Trajectory};
 use super::{Formulation, Output, Simulation};
 use crate::kinematics::KinematicsError;
 use crate::ode::{OdeError, OdeOptions, Tolerances};
-use crate::{Error, Mechanism, MechanismExt, Partition, Preferences, Prescription};
+use crate::workspace::EvalError;
+use crate::{
+    AssemblyError, Error, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
+    Preferences, Prescription,
+};
 
 /// Relative progress below which a recovery counts as a stall.
 const STALL: f64 = 1e-10;
+
+/// Pivot ratio below which constraints are reported as nearly dependent in a failure.
+const NEAR_SINGULAR: f64 = 1e-3;
 
 /// The output times in $(t_0, t_\text{end}]$.
 fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErrorKind> {
@@ -107,6 +114,31 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         Ok(())
     }
 
+    /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
+    /// below [`NEAR_SINGULAR`]) at the last full state: those that lock the mechanism
+    /// when an iteration stalls on a singular Jacobian with a small residual.
+    fn nearly_dependent(&mut self) -> Vec<&'static str> {
+        let sys = &mut self.sys;
+        let Some(&t) = self.traj.t.last() else {
+            return Vec::new();
+        };
+        let params = PartitionParams {
+            pivot_tolerance: NEAR_SINGULAR,
+            ..PartitionParams::default()
+        };
+        match Partition::compute(
+            sys.mech,
+            &mut sys.ws,
+            t,
+            &sys.q,
+            Preferences::default(),
+            &params,
+        ) {
+            Err(PartitionError::RedundantHolonomic { constraints, .. }) => constraints,
+            _ => Vec::new(),
+        }
+    }
+
     fn run(&self, stepper: Option<&Stepper>) -> Run {
         let mut stats = Stats {
             newton_iterations: self.sys.newton_iterations,
@@ -129,7 +161,14 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         }
     }
 
-    fn fail(&mut self, stepper: Option<&Stepper>, kind: SimErrorKind) -> SimError {
+    fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+        if let SimErrorKind::NewtonFailed { constraints, .. }
+        | SimErrorKind::Singular { constraints, .. } = &mut kind
+        {
+            if constraints.is_empty() {
+                *constraints = self.nearly_dependent();
+            }
+        }
         SimError {
             kind,
             partial: Box::new(self.run(stepper)),
@@ -214,22 +253,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     };
     sys.kin
         .assemble(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
-        .map_err(|e| empty(SimErrorKind::Assembly(e)))?;
+        .map_err(|e| empty(assembly_error(e)))?;
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
     if form == Formulation::Partitioning {
-        // A fresh partition without the prescription's preferences: the monitor
-        // compares with the condition at partition time, so start from the best one.
-        let p = Partition::compute(
-            mech,
-            &mut sys.ws,
-            t0,
-            &q,
-            Preferences::default(),
-            &sim.kinematics.partition,
-        )
-        .map_err(|e| empty(SimErrorKind::Analysis(e.into())))?;
-        sys.kin.set_partition(p);
+        // Assembly left its partition current: Algorithm P with the prescribed
+        // coordinates kept independent (exactly Algorithm P without a prescription).
         sys.update_indices();
     }
 
@@ -388,6 +417,23 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         check!(rec.record(t_end));
     }
     Ok(rec.run(Some(&stepper)))
+}
+
+/// A NaN met during assembly is a [`SimErrorKind::NonFinite`]; other failures are
+/// [`SimErrorKind::Assembly`].
+fn assembly_error(e: AssemblyError) -> SimErrorKind {
+    let eval = match &e {
+        AssemblyError::Eval(v)
+        | AssemblyError::Kinematics(
+            KinematicsError::Eval(v) | KinematicsError::Partition(PartitionError::Eval(v)),
+        )
+        | AssemblyError::Partition(PartitionError::Eval(v)) => Some(v),
+        _ => None,
+    };
+    match eval {
+        Some(v @ EvalError::NonFinite { .. }) => SimErrorKind::from_eval(v.clone()),
+        _ => SimErrorKind::Assembly(e),
+    }
 }
 
 fn sys_dim<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>) -> usize {

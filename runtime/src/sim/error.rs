@@ -119,7 +119,7 @@ pub enum SimErrorKind {
         constraints: Vec<&'static str>,
     },
     /// A matrix became singular.
-    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); constraints not met: {constraints:?}")]
+    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); constraints involved: {constraints:?}")]
     Singular {
         /// Time.
         t: f64,
