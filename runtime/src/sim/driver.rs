@@ -80,10 +80,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     /// Monitors at the current full state; returns the violations.
     fn observe(&mut self, t: f64) -> Result<(f64, f64, f64), SimErrorKind> {
-        let v = self
-            .sys
-            .violations(t)
-            .map_err(SimErrorKind::from_eval)?;
+        let v = self.sys.violations(t).map_err(SimErrorKind::from_eval)?;
         let info = self.sys.info;
         let energy = info
             .conservative
@@ -101,7 +98,10 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             .accelerations(t)
             .map_err(|e| SimErrorKind::from_analysis(e, Vec::new()))?;
         let v = self.observe(t)?;
-        let energy = self.monitors.energy_final.filter(|_| self.sys.info.conservative);
+        let energy = self
+            .monitors
+            .energy_final
+            .filter(|_| self.sys.info.conservative);
         self.traj.push(
             t,
             &self.sys.q,

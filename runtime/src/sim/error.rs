@@ -84,7 +84,9 @@ impl fmt::Display for NonFiniteSource {
 #[derive(Debug, thiserror::Error)]
 pub enum SimErrorKind {
     /// The time span or the output times are invalid.
-    #[error("invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value}")]
+    #[error(
+        "invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value}"
+    )]
     InvalidTimes {
         /// Start time.
         t0: f64,
@@ -115,7 +117,9 @@ pub enum SimErrorKind {
         iterations: usize,
         /// Final $\lVert C\rVert_\infty$.
         residual: f64,
-        /// Constraints whose residual exceeds the tolerance.
+        /// Constraints whose residual exceeds the tolerance, or else (a stall on a
+        /// singular Jacobian) those Algorithm P finds nearly dependent at the last
+        /// recorded state.
         constraints: Vec<&'static str>,
     },
     /// A matrix became singular.
@@ -127,8 +131,8 @@ pub enum SimErrorKind {
         matrix: SingularMatrix,
         /// Smallest / largest pivot.
         ratio: f64,
-        /// Holonomic constraints whose residual exceeded the tolerance at that point
-        /// (empty when all were met).
+        /// Holonomic constraints whose residual exceeded the tolerance at that point,
+        /// or else those Algorithm P finds nearly dependent at the last recorded state.
         constraints: Vec<&'static str>,
     },
     /// The step size fell below what the precision of `t` resolves.

@@ -6,6 +6,9 @@ use crate::ode::{
     Adams, Dop853, Dopri5, Integrator, OdeError, OdeOptions, OdeStats, OdeSystem, Rk4,
 };
 
+// One stepper lives per run, so the size of the largest variant (Adams' history) costs
+// nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub(crate) enum Stepper {
     Rk4(Rk4),

@@ -182,8 +182,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
 
     /// Records the holonomic constraints not met by the last iterate of a failed K1.
     fn note_failure(&mut self, e: &KinematicsError) {
-        if let KinematicsError::SingularDependent { .. } | KinematicsError::SingularVelocity { .. } =
-            e
+        if let KinematicsError::SingularDependent { .. }
+        | KinematicsError::SingularVelocity { .. } = e
         {
             let tol = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
             self.failure_constraints = self
@@ -268,7 +268,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         if mh > 0 {
             let mut iterations = 0;
             loop {
-                self.ws.eval_constraints(self.mech, t, &self.q).map_err(eval)?;
+                self.ws
+                    .eval_constraints(self.mech, t, &self.q)
+                    .map_err(eval)?;
                 let residual = inf_norm(self.ws.constraints());
                 let bound = newton.tolerance * (1.0 + inf_norm(&self.q));
                 if residual <= bound {

@@ -15,7 +15,10 @@ fn inconsistent_initial_condition_is_an_assembly_error() {
         .run(1.0)
         .unwrap_err();
     assert!(
-        matches!(err.kind, SimErrorKind::Assembly(AssemblyError::Partition(_))),
+        matches!(
+            err.kind,
+            SimErrorKind::Assembly(AssemblyError::Partition(_))
+        ),
         "{err}"
     );
     assert!(err.partial.trajectory.is_empty());
@@ -111,7 +114,10 @@ fn step_limit_is_a_max_steps_error_with_the_partial_run() {
         .max_steps(100)
         .run(1.0)
         .unwrap_err();
-    assert!(matches!(err.kind, SimErrorKind::MaxSteps { steps: 100, .. }), "{err}");
+    assert!(
+        matches!(err.kind, SimErrorKind::MaxSteps { steps: 100, .. }),
+        "{err}"
+    );
     // A row at the start and one per accepted step.
     assert_eq!(err.partial.stats.steps, 100);
     assert_eq!(err.partial.trajectory.len(), 101);
@@ -126,6 +132,9 @@ fn invalid_times_are_rejected() {
             .output_times(&out)
             .run(t_end)
             .unwrap_err();
-        assert!(matches!(err.kind, SimErrorKind::InvalidTimes { .. }), "{err}");
+        assert!(
+            matches!(err.kind, SimErrorKind::InvalidTimes { .. }),
+            "{err}"
+        );
     }
 }

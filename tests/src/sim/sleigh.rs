@@ -43,7 +43,10 @@ fn v11_closed_form_with_every_formulation() {
                 run.stats.rhs_evals,
                 run.stats.repartitions
             );
-            assert!(worst <= 100.0 * rtol + 5e-13, "{form:?} {method:?}: {worst:e}");
+            assert!(
+                worst <= 100.0 * rtol + 5e-13,
+                "{form:?} {method:?}: {worst:e}"
+            );
             // E = ½ m v² + ½ J ω² = 1.02875 (math-spec V11).
             assert!((m.energy_initial.unwrap() - 1.02875).abs() < 1e-12);
             assert!(m.max_energy_drift.unwrap() < 100.0 * rtol);
