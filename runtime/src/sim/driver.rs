@@ -256,6 +256,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         .map_err(|e| empty(assembly_error(e)))?;
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
+    sys.t_state = t0;
     if form == Formulation::Partitioning {
         // Assembly left its partition current: Algorithm P with the prescribed
         // coordinates kept independent (exactly Algorithm P without a prescription).
@@ -399,6 +400,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 }
                 rec.sys.q.copy_from_slice(&q_acc);
                 rec.sys.qd.copy_from_slice(&qd_acc);
+                rec.sys.t_state = ta;
                 let sys = &mut rec.sys;
                 if sys.kin.repartition(mech, &mut sys.ws, ta, &q_acc).is_err() {
                     bail!(SimErrorKind::from_ode(e, constraints));

@@ -14,7 +14,7 @@
 //! - [`Formulation::Partitioning`] (math-spec Algorithm D): the state is
 //!   $y = [p; \dot\gamma]$ with $p = [\eta; \gamma]$, of dimension
 //!   $2(n - m_h) - m_{nh}$. Each evaluation runs K1 (Newton on $\beta$ from the previous
-//!   evaluation's $\beta$), K2 and (E31). After each accepted step the condition
+//!   evaluation's $\beta$ moved along $\dot\beta$ to the new time), K2 and (E31). After each accepted step the condition
 //!   monitor may re-partition; a failed Newton iteration in a step re-partitions at the
 //!   last accepted state and retries with a smaller step. Both change the meaning of
 //!   $y$, so the integrator restarts (Adams at order 1). Constraints hold to the Newton
@@ -83,7 +83,17 @@ pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
 pub use trajectory::{Monitors, Run, Stats, Trajectory};
 
-use crate::{DynamicsParams, KinematicsParams, Mechanism, PartitionParams};
+use crate::{DynamicsParams, KinematicsParams, Mechanism, NewtonParams, PartitionParams};
+
+/// The simulation's Newton tolerance (K1 and the position projection), relative as in
+/// [`NewtonParams`].
+///
+/// K1 accepts its guess without an update when the residual is already below the
+/// tolerance; with the first-order predictor of the guess that happens at most steps,
+/// and a residual of $10^{-12}$ in the units of $C$ (metres for a loop closure of
+/// centimetre-sized links) leaves angles wrong by $10^{-10}$, which a DOP853 run at
+/// rtol $10^{-12}$ sees as noise. $10^{-14}$ keeps the coordinates at round-off.
+pub const NEWTON_TOLERANCE: f64 = 1e-14;
 
 /// The simulation's re-partition threshold: re-partition when a pivot ratio of the
 /// dependent block falls below this fraction of its value at partition time.
@@ -236,7 +246,10 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
                     deterioration: DETERIORATION,
                     ..PartitionParams::default()
                 },
-                ..KinematicsParams::default()
+                newton: NewtonParams {
+                    tolerance: NEWTON_TOLERANCE,
+                    ..NewtonParams::default()
+                },
             },
             dynamics: DynamicsParams::default(),
             progress: None,
@@ -337,8 +350,8 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
         self
     }
 
-    /// Tuning of K1, K2 and Algorithm P (Newton tolerance, re-partition threshold;
-    /// the default threshold is [`DETERIORATION`]).
+    /// Tuning of K1, K2 and Algorithm P (defaults: Newton tolerance
+    /// [`NEWTON_TOLERANCE`], re-partition threshold [`DETERIORATION`]).
     #[must_use]
     pub fn kinematics(mut self, params: KinematicsParams) -> Self {
         self.kinematics = params;

@@ -46,6 +46,8 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     coords: Vec<usize>,
     gamma: Vec<usize>,
     dim: usize,
+    /// Time of the full state in `q`, `qd` (the base of the next K1 guess).
+    pub t_state: f64,
     pub newton_iterations: u64,
     pub factorizations: u64,
     /// Holonomic constraints not met when the last analysis failed.
@@ -94,6 +96,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             coords: Vec::with_capacity(n),
             gamma: Vec::with_capacity(n),
             dim,
+            t_state: 0.0,
             newton_iterations: 0,
             factorizations: 0,
             failure_constraints: Vec::new(),
@@ -151,6 +154,15 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 for (k, &j) in self.coords.iter().enumerate() {
                     self.q[j] = y[k];
                 }
+                // First-order predictor for the guess of β: the last evaluation's β
+                // moved along its velocity. Without it, fast mechanisms (Andrews) and
+                // long steps let Newton converge to another assembly branch.
+                let dt = t - self.t_state;
+                if let Some(p) = self.kin.partition() {
+                    for &j in p.dependent() {
+                        self.q[j] += self.qd[j] * dt;
+                    }
+                }
                 let r = self.kin.position(self.mech, &mut self.ws, t, &mut self.q);
                 let iterations = self.kin.residual_history().len().saturating_sub(1) as u64;
                 self.newton_iterations += iterations;
@@ -170,6 +182,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     self.note_failure(&e);
                     return Err(e.into());
                 }
+                self.t_state = t;
             }
             _ => {
                 let n = self.q.len();
