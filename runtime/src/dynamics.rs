@@ -225,6 +225,23 @@ impl Dynamics {
         qdd: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<AccelerationStats, DynamicsError> {
+        self.accelerations_shifted(mech, ws, t, q, qd, None, qdd, lambda)
+    }
+
+    /// [`Dynamics::accelerations`] with $\gamma$ replaced by $\gamma + s$ (`shift`,
+    /// length $m$): the stabilized right-hand side of Baumgarte's method.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn accelerations_shifted<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        shift: Option<&[f64]>,
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
         let (n, m) = (info.nq(), info.nh() + info.nnh());
         check_state(info, t, q, Some(qd))?;
@@ -235,6 +252,11 @@ impl Dynamics {
         ws.eval_gamma(mech, t, q, qd)?;
         self.b[..n].copy_from_slice(&ws.forces);
         self.b[n..].copy_from_slice(&ws.gamma);
+        if let Some(shift) = shift {
+            for (b, s) in self.b[n..].iter_mut().zip(shift) {
+                *b += s;
+            }
+        }
         self.redundant.clear();
 
         let stats = if let Some(lu) = self.dense.as_mut() {

@@ -17,6 +17,9 @@
 //!   sparse, with minimum-norm multipliers for redundant constraints.
 //! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
 //!   [`ode::OdeSystem`], with dense output, restarts and statistics.
+//! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
+//!   partitioning, projection or Baumgarte stabilization, any integrator, output at
+//!   requested times, monitors and work-precision sweeps.
 //! - [`Error`]: every module's error, joined.
 
 pub use pfaff_macros::mechanism;
@@ -30,6 +33,7 @@ mod linalg;
 mod mechanism;
 pub mod ode;
 mod partition;
+pub mod sim;
 mod workspace;
 
 pub use assembly::{AssemblyError, AssemblyReport, Prescription};

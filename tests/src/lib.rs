@@ -7,6 +7,8 @@ pub mod sources;
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod sim;
+#[cfg(test)]
 mod snapshots;
 #[cfg(test)]
 mod ui;

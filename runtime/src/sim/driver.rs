@@ -1,0 +1,444 @@
+//! The integration loop behind [`Simulation::run`].
+//!
+//! Input: a configured [`Simulation`] and the end time. Output: a [`Run`], or a
+//! [`SimError`] with the rows recorded so far.
+//!
+//! Per accepted step: project (projection formulation), record the rows whose output
+//! times the step passed (dense output, then reconstruction of the full state), update
+//! the monitors at the accepted state, run the condition monitor (partitioning) and
+//! restart on a re-partition, report progress. A failed K1 inside a step
+//! (partitioning) re-partitions at the last accepted state and restarts with an eighth
+//! of the proposed step; three failures without progress end the run.
+//!
+//! Invariant: after the rows are reserved, the loop does not allocate unless it
+//! re-partitions or fails (the trajectory grows only in [`Output::Steps`] mode).
+
+use std::time::Instant;
+
+use super::error::{SimError, SimErrorKind};
+use super::stepper::Stepper;
+use super::system::MechSystem;
+use super::trajectory::{Monitors, Run, Stats, Trajectory};
+use super::{Formulation, Output, Simulation};
+use crate::kinematics::KinematicsError;
+use crate::ode::{OdeError, OdeOptions, Tolerances};
+use crate::workspace::EvalError;
+use crate::{
+    AssemblyError, Error, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
+    Preferences, Prescription,
+};
+
+/// Relative progress below which a recovery counts as a stall.
+const STALL: f64 = 1e-10;
+
+/// Pivot ratio below which constraints are reported as nearly dependent in a failure.
+const NEAR_SINGULAR: f64 = 1e-3;
+
+/// The output times in $(t_0, t_\text{end}]$.
+fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErrorKind> {
+    let bad = |value| SimErrorKind::InvalidTimes { t0, t_end, value };
+    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+        return Err(bad(t_end));
+    }
+    let span = t_end - t0;
+    match output {
+        Output::Steps => Ok(Vec::new()),
+        Output::Every(dt) => {
+            if !(dt.is_finite() && *dt > 0.0) {
+                return Err(bad(*dt));
+            }
+            let k_max = ((span / dt) * (1.0 + 1e-12)).floor() as usize;
+            Ok((1..=k_max)
+                .map(|k| (t0 + k as f64 * dt).min(t_end))
+                .collect())
+        }
+        Output::Times(times) => {
+            let mut prev = t0;
+            let mut out = Vec::with_capacity(times.len());
+            for &t in times {
+                if !t.is_finite() || t < prev || t > t_end {
+                    return Err(bad(t));
+                }
+                if t > t0 && out.last() != Some(&t) {
+                    out.push(t);
+                }
+                prev = t;
+            }
+            Ok(out)
+        }
+    }
+}
+
+struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
+    sys: MechSystem<'m, M>,
+    traj: Trajectory,
+    monitors: Monitors,
+    started: Instant,
+    y: &'a mut [f64],
+}
+
+impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
+    /// Monitors at the current full state; returns the violations.
+    fn observe(&mut self, t: f64) -> Result<(f64, f64, f64), SimErrorKind> {
+        let v = self.sys.violations(t).map_err(SimErrorKind::from_eval)?;
+        let info = self.sys.info;
+        let energy = info
+            .conservative
+            .then(|| self.sys.mech.energy(t, &self.sys.q, &self.sys.qd));
+        self.monitors.observe(v, energy);
+        if energy.is_some() {
+            self.monitors.energy_final = energy;
+        }
+        Ok(v)
+    }
+
+    /// Records a row at the current full state.
+    fn record(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        self.sys
+            .accelerations(t)
+            .map_err(|e| SimErrorKind::from_analysis(e, Vec::new()))?;
+        let v = self.observe(t)?;
+        let energy = self
+            .monitors
+            .energy_final
+            .filter(|_| self.sys.info.conservative);
+        self.traj.push(
+            t,
+            &self.sys.q,
+            &self.sys.qd,
+            &self.sys.lambda,
+            v.0,
+            v.1.max(v.2),
+            energy,
+        );
+        Ok(())
+    }
+
+    /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
+    /// below [`NEAR_SINGULAR`]) at the last full state: those that lock the mechanism
+    /// when an iteration stalls on a singular Jacobian with a small residual.
+    fn nearly_dependent(&mut self) -> Vec<&'static str> {
+        let sys = &mut self.sys;
+        let Some(&t) = self.traj.t.last() else {
+            return Vec::new();
+        };
+        let params = PartitionParams {
+            pivot_tolerance: NEAR_SINGULAR,
+            ..PartitionParams::default()
+        };
+        match Partition::compute(
+            sys.mech,
+            &mut sys.ws,
+            t,
+            &sys.q,
+            Preferences::default(),
+            &params,
+        ) {
+            Err(PartitionError::RedundantHolonomic { constraints, .. }) => constraints,
+            _ => Vec::new(),
+        }
+    }
+
+    fn run(&self, stepper: Option<&Stepper>) -> Run {
+        let mut stats = Stats {
+            newton_iterations: self.sys.newton_iterations,
+            factorizations: self.sys.factorizations,
+            repartitions: self.sys.kin.repartitions() as u64,
+            wall_time: self.started.elapsed(),
+            ..Stats::default()
+        };
+        if let Some(s) = stepper {
+            let o = s.stats();
+            stats.steps = o.steps;
+            stats.rejected = o.rejected;
+            stats.rhs_evals = o.rhs_evals;
+            stats.restarts = o.restarts.saturating_sub(1);
+        }
+        Run {
+            trajectory: self.traj.clone(),
+            stats,
+            monitors: self.monitors,
+        }
+    }
+
+    fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+        if let SimErrorKind::NewtonFailed { constraints, .. }
+        | SimErrorKind::Singular { constraints, .. } = &mut kind
+        {
+            if constraints.is_empty() {
+                *constraints = self.nearly_dependent();
+            }
+        }
+        SimError {
+            kind,
+            partial: Box::new(self.run(stepper)),
+        }
+    }
+}
+
+/// Whether a right-hand-side failure is a kinematic one that a new partition may cure.
+fn recoverable(e: &OdeError) -> bool {
+    match e {
+        OdeError::Rhs { source, .. } => matches!(
+            source.downcast_ref::<Error>(),
+            Some(Error::Kinematics(
+                KinematicsError::NewtonFailed { .. }
+                    | KinematicsError::SingularDependent { .. }
+                    | KinematicsError::SingularVelocity { .. }
+            ))
+        ),
+        _ => false,
+    }
+}
+
+#[allow(clippy::too_many_lines)]
+pub(super) fn run<M: Mechanism + ?Sized>(
+    sim: &mut Simulation<'_, M>,
+    t_end: f64,
+) -> Result<Run, SimError> {
+    let started = Instant::now();
+    let mech = sim.mech;
+    let info = mech.info();
+    let (n, mh) = (info.nq(), info.nh());
+    let t0 = sim.t0;
+    let form = sim.formulation;
+    let empty = |kind| SimError {
+        kind,
+        partial: Box::new(Run {
+            trajectory: Trajectory::new(info, 0),
+            stats: Stats {
+                wall_time: started.elapsed(),
+                ..Stats::default()
+            },
+            monitors: Monitors::default(),
+        }),
+    };
+    let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
+
+    // Initial guess and assembly.
+    let (mut q, mut qd) = match &sim.initial {
+        Some((q, qd)) => {
+            for (what, v) in [("coordinates", q), ("velocities", qd)] {
+                if v.len() != n {
+                    return Err(empty(SimErrorKind::InitialLength {
+                        what,
+                        found: v.len(),
+                        expected: n,
+                    }));
+                }
+            }
+            (q.clone(), qd.clone())
+        }
+        None => {
+            let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+            mech.initial_state(&mut q, &mut qd);
+            (q, qd)
+        }
+    };
+    let mut sys = MechSystem::new(mech, form, sim.kinematics, sim.dynamics)
+        .map_err(|e| empty(SimErrorKind::Analysis(e)))?;
+    let pq: Vec<(&str, f64)> = sim
+        .prescribed_q
+        .iter()
+        .map(|(s, v)| (s.as_str(), *v))
+        .collect();
+    let pqd: Vec<(&str, f64)> = sim
+        .prescribed_qd
+        .iter()
+        .map(|(s, v)| (s.as_str(), *v))
+        .collect();
+    let prescription = Prescription {
+        coordinates: &pq,
+        velocities: &pqd,
+    };
+    sys.kin
+        .assemble(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
+        .map_err(|e| empty(assembly_error(e)))?;
+    sys.q.copy_from_slice(&q);
+    sys.qd.copy_from_slice(&qd);
+    sys.t_state = t0;
+    if form == Formulation::Partitioning {
+        // Assembly left its partition current: Algorithm P with the prescribed
+        // coordinates kept independent (exactly Algorithm P without a prescription).
+        sys.update_indices();
+    }
+
+    let rows = match sim.output {
+        Output::Steps => 1024,
+        _ => times.len() + 2,
+    };
+    let dim = sys_dim(&sys);
+    let mut y = vec![0.0; dim];
+    let mut rec = Recorder {
+        sys,
+        traj: Trajectory::new(info, rows),
+        monitors: Monitors::default(),
+        started,
+        y: &mut y,
+    };
+    if let Err(kind) = rec.record(t0) {
+        return Err(rec.fail(None, kind));
+    }
+
+    // Integrator.
+    let span = t_end - t0;
+    let mut h_max = sim.h_max.unwrap_or(f64::INFINITY);
+    if form == Formulation::Partitioning && n == mh && sim.h_max.is_none() {
+        // No degrees of freedom: the inert state gives the error control nothing to
+        // measure, so the output spacing bounds the step (K1 needs a near guess).
+        let spacing = match &sim.output {
+            Output::Every(dt) => *dt,
+            Output::Times(_) | Output::Steps => span / 100.0,
+        };
+        h_max = spacing.min(span / 100.0);
+    }
+    let opts = OdeOptions {
+        tol: Tolerances::new(sim.rtol, sim.atol),
+        h_init: sim.h_init,
+        h_max,
+        max_steps: sim.max_steps,
+        dense_output: true,
+    };
+    let mut stepper = match Stepper::new(sim.method, dim, opts) {
+        Ok(s) => s,
+        Err(e) => return Err(rec.fail(None, SimErrorKind::Integrator(e))),
+    };
+    rec.sys.gather(rec.y);
+    if let Err(e) = stepper.reset(&mut rec.sys, t0, rec.y, None) {
+        let c = std::mem::take(&mut rec.sys.failure_constraints);
+        return Err(rec.fail(Some(&stepper), SimErrorKind::from_ode(e, c)));
+    }
+
+    let mut yout = vec![0.0; dim];
+    let mut q_acc = rec.sys.q.clone();
+    let mut qd_acc = rec.sys.qd.clone();
+    let mut next_out = 0;
+    let (mut last_fail_t, mut stalls) = (f64::NEG_INFINITY, 0_u32);
+    let steps_mode = matches!(sim.output, Output::Steps);
+
+    macro_rules! bail {
+        ($kind:expr) => {
+            return Err(rec.fail(Some(&stepper), $kind))
+        };
+    }
+    macro_rules! check {
+        ($e:expr) => {
+            match $e {
+                Ok(v) => v,
+                Err(kind) => bail!(kind),
+            }
+        };
+    }
+    let analysis = |e: Error| SimErrorKind::from_analysis(e, Vec::new());
+    let ode = |e: OdeError| SimErrorKind::from_ode(e, Vec::new());
+
+    while stepper.t() < t_end {
+        let attempts = stepper.stats().steps + stepper.stats().rejected;
+        if attempts >= sim.max_steps {
+            bail!(SimErrorKind::MaxSteps {
+                t: stepper.t(),
+                steps: sim.max_steps
+            });
+        }
+        match stepper.step(&mut rec.sys, Some(t_end)) {
+            Ok(t) => {
+                if form == Formulation::Projection {
+                    rec.y.copy_from_slice(stepper.y());
+                    check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
+                    check!(rec.sys.project(t));
+                    rec.sys.gather(rec.y);
+                    check!(stepper.set_state(rec.y).map_err(ode));
+                }
+                while next_out < times.len() && times[next_out] <= t {
+                    let to = times[next_out];
+                    check!(stepper.interpolate(to, &mut yout).map_err(ode));
+                    check!(rec.sys.reconstruct(to, &yout).map_err(analysis));
+                    if form == Formulation::Projection {
+                        check!(rec.sys.project(to));
+                    }
+                    check!(rec.record(to));
+                    next_out += 1;
+                }
+                rec.y.copy_from_slice(stepper.y());
+                check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
+                if steps_mode {
+                    check!(rec.record(t));
+                } else {
+                    check!(rec.observe(t));
+                }
+                if form == Formulation::Partitioning {
+                    q_acc.copy_from_slice(&rec.sys.q);
+                    qd_acc.copy_from_slice(&rec.sys.qd);
+                    let sys = &mut rec.sys;
+                    let moved = check!(sys
+                        .kin
+                        .monitor(mech, &mut sys.ws, t, &sys.q)
+                        .map_err(|e| analysis(e.into())));
+                    if moved && t < t_end && rec.sys.update_indices() {
+                        rec.sys.gather(rec.y);
+                        check!(stepper.reset(&mut rec.sys, t, rec.y, None).map_err(ode));
+                    }
+                }
+                if let Some(f) = sim.progress.as_mut() {
+                    f(t);
+                }
+            }
+            Err(e) => {
+                let constraints = std::mem::take(&mut rec.sys.failure_constraints);
+                if form != Formulation::Partitioning || !recoverable(&e) {
+                    bail!(SimErrorKind::from_ode(e, constraints));
+                }
+                let ta = stepper.t();
+                if ta - last_fail_t <= STALL * span {
+                    stalls += 1;
+                } else {
+                    stalls = 0;
+                }
+                last_fail_t = ta;
+                if stalls >= 3 || (stepper.is_fixed_step() && stalls >= 1) {
+                    bail!(SimErrorKind::from_ode(e, constraints));
+                }
+                rec.sys.q.copy_from_slice(&q_acc);
+                rec.sys.qd.copy_from_slice(&qd_acc);
+                rec.sys.t_state = ta;
+                let sys = &mut rec.sys;
+                if sys.kin.repartition(mech, &mut sys.ws, ta, &q_acc).is_err() {
+                    bail!(SimErrorKind::from_ode(e, constraints));
+                }
+                rec.sys.update_indices();
+                rec.sys.gather(rec.y);
+                let h = stepper.h_next().abs() / 8.0;
+                let h0 = (!stepper.is_fixed_step() && h.is_finite() && h > 0.0).then_some(h);
+                check!(stepper.reset(&mut rec.sys, ta, rec.y, h0).map_err(ode));
+            }
+        }
+    }
+    if rec.traj.t.last() != Some(&t_end) {
+        rec.y.copy_from_slice(stepper.y());
+        check!(rec.sys.reconstruct(t_end, rec.y).map_err(analysis));
+        check!(rec.record(t_end));
+    }
+    Ok(rec.run(Some(&stepper)))
+}
+
+/// A NaN met during assembly is a [`SimErrorKind::NonFinite`]; other failures are
+/// [`SimErrorKind::Assembly`].
+fn assembly_error(e: AssemblyError) -> SimErrorKind {
+    let eval = match &e {
+        AssemblyError::Eval(v)
+        | AssemblyError::Kinematics(
+            KinematicsError::Eval(v) | KinematicsError::Partition(PartitionError::Eval(v)),
+        )
+        | AssemblyError::Partition(PartitionError::Eval(v)) => Some(v),
+        _ => None,
+    };
+    match eval {
+        Some(v @ EvalError::NonFinite { .. }) => SimErrorKind::from_eval(v.clone()),
+        _ => SimErrorKind::Assembly(e),
+    }
+}
+
+fn sys_dim<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>) -> usize {
+    use crate::ode::OdeSystem;
+    sys.dim()
+}

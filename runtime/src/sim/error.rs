@@ -1,0 +1,304 @@
+//! The error of a simulation: a typed [`SimErrorKind`] together with the partial
+//! [`Run`] computed before the failure.
+//!
+//! Input: failures of assembly, of the analyses inside the right-hand side (boxed as
+//! [`RhsError`](crate::ode::RhsError) by the integrators) and of the integrators.
+//! Output: one kind per cause, each with the time and what is known about it (the
+//! constraints involved, the iterations, the residual).
+
+use std::fmt;
+
+use super::trajectory::Run;
+use crate::dynamics::DynamicsError;
+use crate::kinematics::KinematicsError;
+use crate::ode::{OdeError, Quantity as OdeQuantity};
+use crate::workspace::{EvalError, Quantity};
+use crate::{AssemblyError, Error};
+
+/// Which matrix was singular.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SingularMatrix {
+    /// $C_\beta$ in the position analysis K1 (partitioning).
+    DependentPositions,
+    /// $J_d$ in the velocity analysis K2 (partitioning).
+    DependentVelocities,
+    /// The augmented matrix of (E31) with $J$ of the given rank.
+    Augmented {
+        /// Numerical rank of $J$.
+        rank: usize,
+    },
+    /// $J J^\mathsf{T}$ (or $C_q C_q^\mathsf{T}$) in a projection.
+    Projection,
+}
+
+impl fmt::Display for SingularMatrix {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::DependentPositions => f.write_str("dependent Jacobian `C_beta`"),
+            Self::DependentVelocities => f.write_str("dependent velocity Jacobian `J_d`"),
+            Self::Augmented { rank } => write!(f, "augmented matrix (rank of `J` {rank})"),
+            Self::Projection => f.write_str("projection matrix `J J^T`"),
+        }
+    }
+}
+
+/// Where a NaN or an infinity appeared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NonFiniteSource {
+    /// A function of the model, at entry `(row, col)`.
+    Model {
+        /// The quantity.
+        quantity: Quantity,
+        /// Row (or vector index).
+        row: usize,
+        /// Column, for matrices.
+        col: Option<usize>,
+    },
+    /// A state or derivative of the integrator, at component `component` of its state.
+    Integrator {
+        /// State or derivative.
+        quantity: OdeQuantity,
+        /// Component of the integrator's state.
+        component: usize,
+    },
+}
+
+impl fmt::Display for NonFiniteSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Model {
+                quantity,
+                row,
+                col: Some(c),
+            } => write!(f, "{quantity}, entry ({row}, {c})"),
+            Self::Model { quantity, row, .. } => write!(f, "{quantity}, entry {row}"),
+            Self::Integrator {
+                quantity,
+                component,
+            } => write!(f, "integrator {quantity}, component {component}"),
+        }
+    }
+}
+
+/// Why a simulation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SimErrorKind {
+    /// The time span or the output times are invalid.
+    #[error(
+        "invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value}"
+    )]
+    InvalidTimes {
+        /// Start time.
+        t0: f64,
+        /// End time.
+        t_end: f64,
+        /// The value that is out of order, out of the span or not finite.
+        value: f64,
+    },
+    /// A user-given initial state has the wrong length.
+    #[error("initial {what} has length {found}, expected {expected}")]
+    InitialLength {
+        /// `"coordinates"` or `"velocities"`.
+        what: &'static str,
+        /// Length given.
+        found: usize,
+        /// The model's number of coordinates.
+        expected: usize,
+    },
+    /// Consistent initial conditions could not be assembled.
+    #[error("cannot assemble the initial conditions: {0}")]
+    Assembly(#[from] AssemblyError),
+    /// A Newton iteration (K1 or the position projection) did not converge.
+    #[error("Newton iteration failed at t = {t} after {iterations} iterations: residual {residual:e}, constraints {constraints:?}")]
+    NewtonFailed {
+        /// Time.
+        t: f64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Final $\lVert C\rVert_\infty$.
+        residual: f64,
+        /// Constraints whose residual exceeds the tolerance, or else (a stall on a
+        /// singular Jacobian) those Algorithm P finds nearly dependent at the last
+        /// recorded state.
+        constraints: Vec<&'static str>,
+    },
+    /// A matrix became singular.
+    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); constraints involved: {constraints:?}")]
+    Singular {
+        /// Time.
+        t: f64,
+        /// Which matrix.
+        matrix: SingularMatrix,
+        /// Smallest / largest pivot.
+        ratio: f64,
+        /// Holonomic constraints whose residual exceeded the tolerance at that point,
+        /// or else those Algorithm P finds nearly dependent at the last recorded state.
+        constraints: Vec<&'static str>,
+    },
+    /// The step size fell below what the precision of `t` resolves.
+    #[error("step size {h:e} too small at t = {t}")]
+    StepSizeTooSmall {
+        /// Time of the last accepted state.
+        t: f64,
+        /// Step size.
+        h: f64,
+    },
+    /// More step attempts than allowed.
+    #[error("more than {steps} step attempts, at t = {t}")]
+    MaxSteps {
+        /// Time of the last accepted state.
+        t: f64,
+        /// The limit.
+        steps: u64,
+    },
+    /// A NaN or an infinity.
+    #[error("non-finite value at t = {t} in the {source_of}")]
+    NonFinite {
+        /// Time.
+        t: f64,
+        /// Where it appeared.
+        source_of: NonFiniteSource,
+    },
+    /// Another failure of the analyses (redundant constraints that contradict each
+    /// other, a failed partition, malformed patterns).
+    #[error(transparent)]
+    Analysis(Error),
+    /// Another failure of the integrator (invalid tolerances or step sizes).
+    #[error(transparent)]
+    Integrator(OdeError),
+}
+
+impl SimErrorKind {
+    /// The time of the failure, when it is tied to one.
+    #[must_use]
+    pub fn t(&self) -> Option<f64> {
+        match self {
+            Self::NewtonFailed { t, .. }
+            | Self::Singular { t, .. }
+            | Self::StepSizeTooSmall { t, .. }
+            | Self::MaxSteps { t, .. }
+            | Self::NonFinite { t, .. } => Some(*t),
+            _ => None,
+        }
+    }
+
+    /// Classifies an error of the analyses; `constraints` names the holonomic
+    /// constraints not met when a singular matrix stopped a Newton iteration.
+    pub(crate) fn from_analysis(e: Error, constraints: Vec<&'static str>) -> Self {
+        match e {
+            Error::Kinematics(KinematicsError::NewtonFailed {
+                t,
+                iterations,
+                residual,
+                violated,
+            }) => Self::NewtonFailed {
+                t,
+                iterations,
+                residual,
+                constraints: violated,
+            },
+            Error::Kinematics(KinematicsError::SingularDependent { t, ratio, .. }) => {
+                Self::Singular {
+                    t,
+                    matrix: SingularMatrix::DependentPositions,
+                    ratio,
+                    constraints,
+                }
+            }
+            Error::Kinematics(KinematicsError::SingularVelocity { t, ratio }) => Self::Singular {
+                t,
+                matrix: SingularMatrix::DependentVelocities,
+                ratio,
+                constraints,
+            },
+            Error::Dynamics(DynamicsError::Singular { t, rank, ratio }) => Self::Singular {
+                t,
+                matrix: SingularMatrix::Augmented { rank },
+                ratio,
+                constraints,
+            },
+            Error::Eval(e)
+            | Error::Kinematics(KinematicsError::Eval(e))
+            | Error::Dynamics(DynamicsError::Eval(e)) => Self::from_eval(e),
+            other => Self::Analysis(other),
+        }
+    }
+
+    pub(crate) fn from_eval(e: EvalError) -> Self {
+        match e {
+            EvalError::NonFinite {
+                quantity,
+                t,
+                row,
+                col,
+                ..
+            } => Self::NonFinite {
+                t,
+                source_of: NonFiniteSource::Model { quantity, row, col },
+            },
+            other => Self::Analysis(other.into()),
+        }
+    }
+
+    /// Classifies an integrator error, unwrapping the analyses' errors from the
+    /// right-hand side.
+    pub(crate) fn from_ode(e: OdeError, constraints: Vec<&'static str>) -> Self {
+        match e {
+            OdeError::StepSizeTooSmall { t, h } => Self::StepSizeTooSmall { t, h },
+            OdeError::MaxStepsExceeded { t, steps } => Self::MaxSteps { t, steps },
+            OdeError::NonFinite {
+                t,
+                component,
+                quantity,
+            } => Self::NonFinite {
+                t,
+                source_of: NonFiniteSource::Integrator {
+                    quantity,
+                    component,
+                },
+            },
+            e @ OdeError::Rhs { .. } => match e.into_rhs_error::<Error>() {
+                Ok((_, inner)) => Self::from_analysis(inner, constraints),
+                Err(other) => Self::Integrator(other),
+            },
+            other => Self::Integrator(other),
+        }
+    }
+}
+
+/// A failed simulation: why, and the run up to the failure.
+#[derive(Debug)]
+pub struct SimError {
+    /// The cause.
+    pub kind: SimErrorKind,
+    /// Rows, statistics and monitors up to the last accepted step before the failure.
+    pub partial: Box<Run>,
+}
+
+impl SimError {
+    /// The time of the failure, when it is tied to one.
+    #[must_use]
+    pub fn t(&self) -> Option<f64> {
+        self.kind.t()
+    }
+}
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "simulation failed: {}", self.kind)?;
+        if let Some((t, _, _)) = self.partial.final_state() {
+            write!(
+                f,
+                " ({} rows kept, the last at t = {t})",
+                self.partial.trajectory.len()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for SimError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.kind)
+    }
+}

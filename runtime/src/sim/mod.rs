@@ -1,0 +1,382 @@
+//! Simulation of a mechanism over time: assembly, a run-time choice of formulation and
+//! integrator, output at requested times, monitors, statistics and typed failures.
+//!
+//! Input: a [`Mechanism`] (also `&dyn Mechanism`), a [`Formulation`], a [`Method`],
+//! tolerances and output times. Output: a [`Run`] (trajectory, [`Stats`], [`Monitors`])
+//! or a [`SimError`] that keeps the partial run.
+//!
+//! # Formulations
+//! With $J = [C_q; G]$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (math-spec §4–§5), the
+//! accelerations come from the augmented system (E31)
+//! $$\begin{bmatrix}M & J^\mathsf{T}\\ J & 0\end{bmatrix}
+//!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
+//!   \begin{bmatrix}Q\\ \gamma\end{bmatrix}.$$
+//! - [`Formulation::Partitioning`] (math-spec Algorithm D): the state is
+//!   $y = [p; \dot\gamma]$ with $p = [\eta; \gamma]$, of dimension
+//!   $2(n - m_h) - m_{nh}$. Each evaluation runs K1 (Newton on $\beta$ from the previous
+//!   evaluation's $\beta$ moved along $\dot\beta$ to the new time), K2 and (E31). After each accepted step the condition
+//!   monitor may re-partition; a failed Newton iteration in a step re-partitions at the
+//!   last accepted state and retries with a smaller step. Both change the meaning of
+//!   $y$, so the integrator restarts (Adams at order 1). Constraints hold to the Newton
+//!   tolerance at every evaluation: no drift.
+//! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
+//!   step $q$ is projected onto $C(q,t) = 0$ by Newton with minimum-norm corrections
+//!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and $\dot q$ onto
+//!   $J\dot q + [C_t; g] = 0$ by
+//!   $\dot q \leftarrow \dot q - J^\mathsf{T}(JJ^\mathsf{T})^{-1}(J\dot q + [C_t; g])$,
+//!   handed back with [`Integrator::set_state`](crate::ode::Integrator::set_state).
+//!   The projections are dense in $m$.
+//! - [`Formulation::Baumgarte`]: index 1 on $y = [q; \dot q]$ with
+//!   $\gamma_h \leftarrow \gamma_h - 2\alpha(C_q\dot q + C_t) - \beta^2 C$ and
+//!   $\gamma_{nh} \leftarrow \gamma_{nh} - 2\alpha(G\dot q + g)$, so that the
+//!   violations obey $\ddot C + 2\alpha\dot C + \beta^2 C = 0$ and
+//!   $\dot h + 2\alpha h = 0$ ($h = G\dot q + g$): they are damped, not removed.
+//!   [`Formulation::baumgarte`] gives the defaults $\alpha = \beta = 10\ \text{s}^{-1}$
+//!   (critical damping, time constant 0.1 s; choose them a few times faster than the
+//!   motion of interest and slower than what the step size can resolve).
+//!
+//! # Example
+//! ```
+//! use pfaff::sim::{Formulation, Method, Simulation};
+//!
+//! /// A point mass on a rigid link, in Cartesian coordinates.
+//! #[pfaff::mechanism]
+//! pub mod pendulum {
+//!     const m: f64 = 1.0;
+//!     const l: f64 = 1.0;
+//!     const g: f64 = 9.81;
+//!     static x: Coordinate = Coordinate { q0: l, qd0: 0.0 };
+//!     static y: Coordinate = Coordinate {};
+//!     fn kinetic_energy() -> f64 {
+//!         0.5 * m * (x.dot().powi(2) + y.dot().powi(2))
+//!     }
+//!     fn potential_energy() -> f64 {
+//!         m * g * y
+//!     }
+//!     #[holonomic]
+//!     fn rod() -> f64 {
+//!         x.powi(2) + y.powi(2) - l.powi(2)
+//!     }
+//! }
+//!
+//! let model = pendulum::Model::default();
+//! let run = Simulation::new(&model)
+//!     .formulation(Formulation::Partitioning)
+//!     .integrator(Method::Dop853)
+//!     .tolerances(1e-10, 1e-12)
+//!     .output_every(0.1)
+//!     .run(2.0)?;
+//! assert_eq!(run.trajectory.len(), 21);
+//! assert!(run.monitors.max_position_violation < 1e-10);
+//! assert!(run.monitors.max_energy_drift.unwrap() < 1e-7);
+//! # Ok::<(), pfaff::sim::SimError>(())
+//! ```
+
+mod driver;
+mod error;
+mod precision;
+mod stepper;
+mod system;
+mod trajectory;
+
+pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
+pub use precision::{format_table, work_precision, Reference, Row, Sweep};
+pub use trajectory::{Monitors, Run, Stats, Trajectory};
+
+use crate::{DynamicsParams, KinematicsParams, Mechanism, NewtonParams, PartitionParams};
+
+/// The simulation's Newton tolerance (K1 and the position projection), relative as in
+/// [`NewtonParams`].
+///
+/// K1 accepts its guess without an update when the residual is already below the
+/// tolerance; with the first-order predictor of the guess that happens at most steps,
+/// and a residual of $10^{-12}$ in the units of $C$ (metres for a loop closure of
+/// centimetre-sized links) leaves angles wrong by $10^{-10}$, which a DOP853 run at
+/// rtol $10^{-12}$ sees as noise. $10^{-14}$ keeps the coordinates at round-off.
+pub const NEWTON_TOLERANCE: f64 = 1e-14;
+
+/// The simulation's re-partition threshold: re-partition when a pivot ratio of the
+/// dependent block falls below this fraction of its value at partition time.
+///
+/// Algorithm P suggests $10^{-3}$ for kinematic analysis, but the state-space ODE (E36)
+/// is as ill-conditioned as $C_\beta$: with the Cartesian pendulum and $\beta = \{x\}$,
+/// $\dot x = -y\dot y/x$, so at a ratio of $10^{-3}$ the dependent velocity amplifies
+/// errors in $\dot y$ a thousandfold and fixed-step or loosely controlled runs lose the
+/// solution before the switch. At $0.3$ the amplification stays below about 3. A
+/// re-partition that picks the same coordinates only renews the reference ratios and does
+/// not restart the integrator.
+pub const DETERIORATION: f64 = 0.3;
+
+/// How the constrained equations become an ODE (see the [module docs](self)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Formulation {
+    /// Coordinate partitioning, math-spec Algorithm D.
+    Partitioning,
+    /// Index 1 with projection of positions and velocities after each step.
+    Projection,
+    /// Index 1 with Baumgarte stabilization.
+    Baumgarte {
+        /// Velocity-level gain $\alpha$ [1/s].
+        alpha: f64,
+        /// Position-level gain $\beta$ [1/s].
+        beta: f64,
+    },
+}
+
+impl Formulation {
+    /// Baumgarte with the defaults $\alpha = \beta = 10\ \text{s}^{-1}$.
+    #[must_use]
+    pub const fn baumgarte() -> Self {
+        Self::Baumgarte {
+            alpha: 10.0,
+            beta: 10.0,
+        }
+    }
+
+    /// The three formulations (Baumgarte with its defaults).
+    pub const ALL: [Self; 3] = [Self::Partitioning, Self::Projection, Self::baumgarte()];
+
+    /// A short name.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Partitioning => "partitioning",
+            Self::Projection => "projection",
+            Self::Baumgarte { .. } => "baumgarte",
+        }
+    }
+}
+
+/// The integrator (see [`crate::ode`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// Classical Runge–Kutta 4 with the fixed step `h` (tolerances are ignored).
+    Rk4 {
+        /// Step size.
+        h: f64,
+    },
+    /// Dormand–Prince 5(4).
+    Dopri5,
+    /// Dormand–Prince 8(5,3).
+    Dop853,
+    /// Shampine–Gordon variable-order Adams.
+    Adams,
+}
+
+impl Method {
+    /// The adaptive methods.
+    pub const ADAPTIVE: [Self; 3] = [Self::Dopri5, Self::Dop853, Self::Adams];
+
+    /// A short name.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Rk4 { .. } => "rk4",
+            Self::Dopri5 => "dopri5",
+            Self::Dop853 => "dop853",
+            Self::Adams => "adams",
+        }
+    }
+}
+
+/// Where rows of the trajectory are taken.
+#[derive(Clone, Debug, PartialEq)]
+enum Output {
+    Steps,
+    Every(f64),
+    Times(Vec<f64>),
+}
+
+/// A simulation, configured by a builder and started by [`run`](Self::run).
+///
+/// Defaults: partitioning, DOP853, `rtol = 1e-6`, `atol = 1e-8`, a row at every
+/// accepted step, start at $t = 0$ from the model's
+/// [`initial_state`](Mechanism::initial_state), at most $10^6$ step attempts.
+pub struct Simulation<'a, M: Mechanism + ?Sized> {
+    mech: &'a M,
+    formulation: Formulation,
+    method: Method,
+    rtol: f64,
+    atol: f64,
+    h_init: Option<f64>,
+    h_max: Option<f64>,
+    max_steps: u64,
+    output: Output,
+    t0: f64,
+    initial: Option<(Vec<f64>, Vec<f64>)>,
+    prescribed_q: Vec<(String, f64)>,
+    prescribed_qd: Vec<(String, f64)>,
+    kinematics: KinematicsParams,
+    dynamics: DynamicsParams,
+    progress: Option<Box<dyn FnMut(f64) + 'a>>,
+}
+
+impl<M: Mechanism + ?Sized> std::fmt::Debug for Simulation<'_, M> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Simulation")
+            .field("model", &self.mech.info().name)
+            .field("formulation", &self.formulation)
+            .field("method", &self.method)
+            .field("rtol", &self.rtol)
+            .field("atol", &self.atol)
+            .field("output", &self.output)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
+    /// A simulation of `mech` with the defaults.
+    pub fn new(mech: &'a M) -> Self {
+        Self {
+            mech,
+            formulation: Formulation::Partitioning,
+            method: Method::Dop853,
+            rtol: 1e-6,
+            atol: 1e-8,
+            h_init: None,
+            h_max: None,
+            max_steps: 1_000_000,
+            output: Output::Steps,
+            t0: 0.0,
+            initial: None,
+            prescribed_q: Vec::new(),
+            prescribed_qd: Vec::new(),
+            kinematics: KinematicsParams {
+                partition: PartitionParams {
+                    deterioration: DETERIORATION,
+                    ..PartitionParams::default()
+                },
+                newton: NewtonParams {
+                    tolerance: NEWTON_TOLERANCE,
+                    ..NewtonParams::default()
+                },
+            },
+            dynamics: DynamicsParams::default(),
+            progress: None,
+        }
+    }
+
+    /// The formulation.
+    #[must_use]
+    pub fn formulation(mut self, formulation: Formulation) -> Self {
+        self.formulation = formulation;
+        self
+    }
+
+    /// The integrator.
+    #[must_use]
+    pub fn integrator(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// Relative and absolute tolerances of the adaptive integrators.
+    #[must_use]
+    pub fn tolerances(mut self, rtol: f64, atol: f64) -> Self {
+        self.rtol = rtol;
+        self.atol = atol;
+        self
+    }
+
+    /// The first step size (and after every restart the method chooses again).
+    #[must_use]
+    pub fn initial_step(mut self, h: f64) -> Self {
+        self.h_init = Some(h);
+        self
+    }
+
+    /// The largest step size.
+    #[must_use]
+    pub fn max_step(mut self, h: f64) -> Self {
+        self.h_max = Some(h);
+        self
+    }
+
+    /// The largest number of step attempts (accepted and rejected, over all restarts).
+    #[must_use]
+    pub fn max_steps(mut self, n: u64) -> Self {
+        self.max_steps = n;
+        self
+    }
+
+    /// Rows at these times (increasing, within the span), by dense output; the start
+    /// and the end are always recorded.
+    #[must_use]
+    pub fn output_times(mut self, times: &[f64]) -> Self {
+        self.output = Output::Times(times.to_vec());
+        self
+    }
+
+    /// Rows every `dt` from the start, by dense output; the end is always recorded.
+    #[must_use]
+    pub fn output_every(mut self, dt: f64) -> Self {
+        self.output = Output::Every(dt);
+        self
+    }
+
+    /// A row at every accepted step (the default).
+    #[must_use]
+    pub fn output_steps(mut self) -> Self {
+        self.output = Output::Steps;
+        self
+    }
+
+    /// The start time (default 0).
+    #[must_use]
+    pub fn start_time(mut self, t0: f64) -> Self {
+        self.t0 = t0;
+        self
+    }
+
+    /// The initial guess of $(q, \dot q)$ instead of the model's `initial_state`; it is
+    /// made consistent by assembly.
+    #[must_use]
+    pub fn initial_state(mut self, q: &[f64], qd: &[f64]) -> Self {
+        self.initial = Some((q.to_vec(), qd.to_vec()));
+        self
+    }
+
+    /// Holds coordinate `name` at `value` during assembly.
+    #[must_use]
+    pub fn prescribe_coordinate(mut self, name: &str, value: f64) -> Self {
+        self.prescribed_q.push((name.to_owned(), value));
+        self
+    }
+
+    /// Holds the velocity of coordinate `name` at `value` during assembly.
+    #[must_use]
+    pub fn prescribe_velocity(mut self, name: &str, value: f64) -> Self {
+        self.prescribed_qd.push((name.to_owned(), value));
+        self
+    }
+
+    /// Tuning of K1, K2 and Algorithm P (defaults: Newton tolerance
+    /// [`NEWTON_TOLERANCE`], re-partition threshold [`DETERIORATION`]).
+    #[must_use]
+    pub fn kinematics(mut self, params: KinematicsParams) -> Self {
+        self.kinematics = params;
+        self
+    }
+
+    /// Tuning of the augmented solve (dense or sparse path).
+    #[must_use]
+    pub fn dynamics(mut self, params: DynamicsParams) -> Self {
+        self.dynamics = params;
+        self
+    }
+
+    /// Calls `f(t)` after every accepted step (for a progress bar).
+    #[must_use]
+    pub fn on_progress(mut self, f: impl FnMut(f64) + 'a) -> Self {
+        self.progress = Some(Box::new(f));
+        self
+    }
+
+    /// Simulates from the start time to `t_end`.
+    ///
+    /// # Errors
+    /// A [`SimError`] with the cause and the rows computed before it.
+    pub fn run(&mut self, t_end: f64) -> Result<Run, SimError> {
+        driver::run(self, t_end)
+    }
+}

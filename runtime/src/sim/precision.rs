@@ -1,0 +1,202 @@
+//! Work-precision sweeps: final error against work for every formulation × integrator
+//! over a range of tolerances.
+//!
+//! Input: a mechanism, a [`Sweep`] and a [`Reference`] (named coordinates and velocities
+//! at the end time). Output: one [`Row`] per run, failed runs included, and a plain-text
+//! table ([`format_table`]). The command-line program reuses both.
+
+use std::fmt::Write as _;
+use std::time::Duration;
+
+use super::{Formulation, Method, Run, Simulation};
+use crate::Mechanism;
+
+/// Reference values at the end time, by coordinate name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reference {
+    /// `(coordinate, value)`.
+    pub coordinates: Vec<(String, f64)>,
+    /// `(coordinate, velocity)`.
+    pub velocities: Vec<(String, f64)>,
+}
+
+impl Reference {
+    /// All coordinates and velocities of the final row of `run`.
+    #[must_use]
+    pub fn from_run(run: &Run) -> Self {
+        let info = run.trajectory.info();
+        let Some((_, q, qd)) = run.final_state() else {
+            return Self::default();
+        };
+        let named = |v: &[f64]| {
+            info.coordinates
+                .iter()
+                .zip(v)
+                .map(|(s, &x)| (s.name.to_owned(), x))
+                .collect()
+        };
+        Self {
+            coordinates: named(q),
+            velocities: named(qd),
+        }
+    }
+
+    /// The largest absolute difference between the final row of `run` and the
+    /// reference values (`NaN` for an unknown name or an empty run).
+    #[must_use]
+    pub fn error(&self, run: &Run) -> f64 {
+        let info = run.trajectory.info();
+        let Some((_, q, qd)) = run.final_state() else {
+            return f64::NAN;
+        };
+        let mut err = 0.0_f64;
+        for (list, v) in [(&self.coordinates, q), (&self.velocities, qd)] {
+            for (name, x) in list {
+                match info.coordinate_index(name) {
+                    Some(j) => err = err.max((v[j] - x).abs()),
+                    None => return f64::NAN,
+                }
+            }
+        }
+        err
+    }
+}
+
+/// What to sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sweep {
+    /// End time (the start is 0, from the model's initial state).
+    pub t_end: f64,
+    /// Relative tolerances; `atol = rtol × atol_ratio`. For RK4 the fixed step is
+    /// $h = t_\text{end}\,\text{rtol}^{1/4}/10$.
+    pub rtols: Vec<f64>,
+    /// `atol / rtol`.
+    pub atol_ratio: f64,
+    /// Formulations.
+    pub formulations: Vec<Formulation>,
+    /// Integrators (the step of [`Method::Rk4`] is replaced as said above).
+    pub methods: Vec<Method>,
+}
+
+impl Sweep {
+    /// rtol = 1e-3 … 1e-12 by decades, atol = rtol/100, every formulation and method.
+    #[must_use]
+    pub fn standard(t_end: f64) -> Self {
+        Self {
+            t_end,
+            rtols: (3..=12).map(|k| 10f64.powi(-k)).collect(),
+            atol_ratio: 1e-2,
+            formulations: Formulation::ALL.to_vec(),
+            methods: vec![
+                Method::Rk4 { h: 0.0 },
+                Method::Dopri5,
+                Method::Dop853,
+                Method::Adams,
+            ],
+        }
+    }
+}
+
+/// One run of a sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Integrator (with the step actually used for RK4).
+    pub method: Method,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Final error against the reference (`NaN` when the run failed).
+    pub error: f64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Re-partitions.
+    pub repartitions: u64,
+    /// Wall-clock time.
+    pub wall_time: Duration,
+    /// The error message of a failed run.
+    pub failure: Option<String>,
+}
+
+/// Runs every formulation × method × tolerance of `sweep` on `mech` from its initial
+/// state and measures the final error against `reference`.
+pub fn work_precision<M: Mechanism + ?Sized>(
+    mech: &M,
+    sweep: &Sweep,
+    reference: &Reference,
+) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for &formulation in &sweep.formulations {
+        for &method in &sweep.methods {
+            for &rtol in &sweep.rtols {
+                let method = match method {
+                    Method::Rk4 { .. } => Method::Rk4 {
+                        h: sweep.t_end * rtol.powf(0.25) / 10.0,
+                    },
+                    m => m,
+                };
+                let result = Simulation::new(mech)
+                    .formulation(formulation)
+                    .integrator(method)
+                    .tolerances(rtol, rtol * sweep.atol_ratio)
+                    .output_times(&[])
+                    .run(sweep.t_end);
+                let (run, failure) = match result {
+                    Ok(run) => (run, None),
+                    Err(e) => {
+                        let msg = e.kind.to_string();
+                        (*e.partial, Some(msg))
+                    }
+                };
+                rows.push(Row {
+                    formulation,
+                    method,
+                    rtol,
+                    error: if failure.is_some() {
+                        f64::NAN
+                    } else {
+                        reference.error(&run)
+                    },
+                    rhs_evals: run.stats.rhs_evals,
+                    steps: run.stats.steps,
+                    repartitions: run.stats.repartitions,
+                    wall_time: run.stats.wall_time,
+                    failure,
+                });
+            }
+        }
+    }
+    rows
+}
+
+/// A plain-text table of `rows`, one line each.
+#[must_use]
+pub fn format_table(rows: &[Row]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<13} {:<7} {:>8} {:>10} {:>9} {:>8} {:>6} {:>11}",
+        "formulation", "method", "rtol", "error", "rhs", "steps", "repart", "wall [ms]"
+    );
+    for r in rows {
+        let _ = write!(
+            s,
+            "{:<13} {:<7} {:>8.0e} {:>10.2e} {:>9} {:>8} {:>6} {:>11.3}",
+            r.formulation.name(),
+            r.method.name(),
+            r.rtol,
+            r.error,
+            r.rhs_evals,
+            r.steps,
+            r.repartitions,
+            r.wall_time.as_secs_f64() * 1e3
+        );
+        if let Some(f) = &r.failure {
+            let _ = write!(s, "  FAILED: {f}");
+        }
+        s.push('\n');
+    }
+    s
+}

@@ -1,0 +1,86 @@
+//! Run-time choice of the integrator: an enum over the four methods, since
+//! [`Integrator`] has generic methods and is not object safe.
+
+use super::Method;
+use crate::ode::{
+    Adams, Dop853, Dopri5, Integrator, OdeError, OdeOptions, OdeStats, OdeSystem, Rk4,
+};
+
+// One stepper lives per run, so the size of the largest variant (Adams' history) costs
+// nothing worth a box.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub(crate) enum Stepper {
+    Rk4(Rk4),
+    Dopri5(Dopri5),
+    Dop853(Dop853),
+    Adams(Adams),
+}
+
+macro_rules! each {
+    ($self:expr, $i:ident => $body:expr) => {
+        match $self {
+            Stepper::Rk4($i) => $body,
+            Stepper::Dopri5($i) => $body,
+            Stepper::Dop853($i) => $body,
+            Stepper::Adams($i) => $body,
+        }
+    };
+}
+
+impl Stepper {
+    pub fn new(method: Method, dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
+        Ok(match method {
+            Method::Rk4 { h } => Self::Rk4(Rk4::new(dim, h)?.with_max_steps(opts.max_steps)),
+            Method::Dopri5 => Self::Dopri5(Dopri5::new(dim, opts)?),
+            Method::Dop853 => Self::Dop853(Dop853::new(dim, opts)?),
+            Method::Adams => Self::Adams(Adams::new(dim, opts)?),
+        })
+    }
+
+    pub fn is_fixed_step(&self) -> bool {
+        matches!(self, Self::Rk4(_))
+    }
+
+    pub fn reset<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t0: f64,
+        y0: &[f64],
+        h0: Option<f64>,
+    ) -> Result<(), OdeError> {
+        each!(self, i => i.reset(sys, t0, y0, h0))
+    }
+
+    pub fn step<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t_stop: Option<f64>,
+    ) -> Result<f64, OdeError> {
+        each!(self, i => i.step(sys, t_stop))
+    }
+
+    pub fn t(&self) -> f64 {
+        each!(self, i => i.t())
+    }
+
+    pub fn y(&self) -> &[f64] {
+        each!(self, i => i.y())
+    }
+
+    pub fn h_next(&self) -> f64 {
+        each!(self, i => i.h_next())
+    }
+
+    pub fn interpolate(&self, t: f64, out: &mut [f64]) -> Result<(), OdeError> {
+        each!(self, i => i.interpolate(t, out))
+    }
+
+    pub fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
+        each!(self, i => i.set_state(y))
+    }
+
+    pub fn stats(&self) -> &OdeStats {
+        each!(self, i => i.stats())
+    }
+}

@@ -1,0 +1,408 @@
+//! The state-space right-hand side of each [`Formulation`], and the corrections and
+//! evaluations the driver applies to accepted and output states.
+//!
+//! Input: a mechanism, a formulation and the analysis scratch. Output: an
+//! [`OdeSystem`] on
+//! - partitioning: $y = [p; \dot\gamma]$, $p = [\eta; \gamma]$, $\dot y = [\dot\eta;
+//!   \dot\gamma; \ddot\gamma]$ (Algorithm D; a mechanism without degrees of freedom gets
+//!   one inert component so that the integrators have a state);
+//! - projection and Baumgarte: $y = [q; \dot q]$, $\dot y = [\dot q; \ddot q]$.
+//!
+//! Invariant: all buffers are sized in [`MechSystem::new`]; `rhs`, `reconstruct`,
+//! `project`, `accelerations` and `violations` do not allocate (except when building an
+//! error).
+
+use super::error::{SimErrorKind, SingularMatrix};
+use super::Formulation;
+use crate::dynamics::{Dynamics, DynamicsParams};
+use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams};
+use crate::linalg::dense::DenseLu;
+use crate::linalg::inf_norm;
+use crate::ode::{OdeSystem, RhsError};
+use crate::workspace::{EvalError, Workspace};
+use crate::{Error, Info, Mechanism};
+
+/// Pivot ratio below which the projection matrix counts as singular.
+const SINGULAR_RATIO: f64 = 1e-14;
+
+pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
+    pub mech: &'a M,
+    pub info: &'static Info,
+    pub form: Formulation,
+    pub ws: Workspace,
+    pub kin: Kinematics,
+    pub dynamics: Dynamics,
+    /// Current full coordinates (also the Newton guess of the next K1).
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub lambda: Vec<f64>,
+    shift: Vec<f64>,
+    vel: Vec<f64>,
+    mu: Vec<f64>,
+    lu_h: DenseLu,
+    lu_v: DenseLu,
+    /// Partitioning: $[\eta; \gamma]$ and $\gamma$.
+    coords: Vec<usize>,
+    gamma: Vec<usize>,
+    dim: usize,
+    /// Time of the full state in `q`, `qd` (the base of the next K1 guess).
+    pub t_state: f64,
+    pub newton_iterations: u64,
+    pub factorizations: u64,
+    /// Holonomic constraints not met when the last analysis failed.
+    pub failure_constraints: Vec<&'static str>,
+}
+
+impl<M: Mechanism + ?Sized> std::fmt::Debug for MechSystem<'_, M> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MechSystem")
+            .field("model", &self.info.name)
+            .field("form", &self.form)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
+    pub fn new(
+        mech: &'a M,
+        form: Formulation,
+        kin: KinematicsParams,
+        dynamics: DynamicsParams,
+    ) -> Result<Self, Error> {
+        let info = mech.info();
+        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        let dim = match form {
+            Formulation::Partitioning => (2 * (n - mh) - info.nnh()).max(1),
+            _ => 2 * n,
+        };
+        let projection = matches!(form, Formulation::Projection);
+        Ok(Self {
+            mech,
+            info,
+            form,
+            ws: Workspace::new(info)?,
+            kin: Kinematics::new(info, kin),
+            dynamics: Dynamics::new(info, dynamics)?,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            lambda: vec![0.0; m],
+            shift: vec![0.0; m],
+            vel: vec![0.0; m],
+            mu: vec![0.0; m],
+            lu_h: DenseLu::new(if projection { mh } else { 0 }, 1),
+            lu_v: DenseLu::new(if projection { m } else { 0 }, 1),
+            coords: Vec::with_capacity(n),
+            gamma: Vec::with_capacity(n),
+            dim,
+            t_state: 0.0,
+            newton_iterations: 0,
+            factorizations: 0,
+            failure_constraints: Vec::new(),
+        })
+    }
+
+    /// Copies the index sets of the current partition (no allocation: the capacity is
+    /// `n`); returns whether they changed.
+    pub fn update_indices(&mut self) -> bool {
+        let p = self
+            .kin
+            .partition()
+            .expect("partitioning keeps a partition");
+        let (eta, ind) = (p.dependent_velocity(), p.independent());
+        let same = self.coords.len() == eta.len() + ind.len()
+            && self.coords[..eta.len()] == *eta
+            && self.coords[eta.len()..] == *ind;
+        if same {
+            return false;
+        }
+        self.coords.clear();
+        self.coords.extend_from_slice(p.dependent_velocity());
+        self.coords.extend_from_slice(p.independent());
+        self.gamma.clear();
+        self.gamma.extend_from_slice(p.independent());
+        true
+    }
+
+    /// Writes the state vector of the current full state `q`, `qd` into `y`.
+    pub fn gather(&self, y: &mut [f64]) {
+        match self.form {
+            Formulation::Partitioning => {
+                y.fill(0.0);
+                let np = self.coords.len();
+                for (k, &j) in self.coords.iter().enumerate() {
+                    y[k] = self.q[j];
+                }
+                for (k, &j) in self.gamma.iter().enumerate() {
+                    y[np + k] = self.qd[j];
+                }
+            }
+            _ => {
+                let n = self.q.len();
+                y[..n].copy_from_slice(&self.q);
+                y[n..].copy_from_slice(&self.qd);
+            }
+        }
+    }
+
+    /// Fills the full `q`, `qd` from the state `y` at `t` (K1 and K2 for partitioning).
+    pub fn reconstruct(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        match self.form {
+            Formulation::Partitioning => {
+                let np = self.coords.len();
+                for (k, &j) in self.coords.iter().enumerate() {
+                    self.q[j] = y[k];
+                }
+                // First-order predictor for the guess of β: the last evaluation's β
+                // moved along its velocity. Without it, fast mechanisms (Andrews) and
+                // long steps let Newton converge to another assembly branch.
+                let dt = t - self.t_state;
+                if let Some(p) = self.kin.partition() {
+                    for &j in p.dependent() {
+                        self.q[j] += self.qd[j] * dt;
+                    }
+                }
+                let r = self.kin.position(self.mech, &mut self.ws, t, &mut self.q);
+                let iterations = self.kin.residual_history().len().saturating_sub(1) as u64;
+                self.newton_iterations += iterations;
+                self.factorizations += iterations;
+                if let Err(e) = r {
+                    self.note_failure(&e);
+                    return Err(e.into());
+                }
+                for (k, &j) in self.gamma.iter().enumerate() {
+                    self.qd[j] = y[np + k];
+                }
+                self.factorizations += 1;
+                if let Err(e) = self
+                    .kin
+                    .velocity(self.mech, &mut self.ws, t, &self.q, &mut self.qd)
+                {
+                    self.note_failure(&e);
+                    return Err(e.into());
+                }
+                self.t_state = t;
+            }
+            _ => {
+                let n = self.q.len();
+                self.q.copy_from_slice(&y[..n]);
+                self.qd.copy_from_slice(&y[n..]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Records the holonomic constraints not met by the last iterate of a failed K1.
+    fn note_failure(&mut self, e: &KinematicsError) {
+        if let KinematicsError::SingularDependent { .. }
+        | KinematicsError::SingularVelocity { .. } = e
+        {
+            let tol = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
+            self.failure_constraints = self
+                .ws
+                .constraints()
+                .iter()
+                .zip(self.info.holonomic)
+                .filter(|(c, _)| c.is_nan() || c.abs() > tol)
+                .map(|(_, s)| s.name)
+                .collect();
+        }
+    }
+
+    /// $\ddot q$ and $\lambda$ at the full state (with the stabilization term for
+    /// Baumgarte).
+    pub fn accelerations(&mut self, t: f64) -> Result<(), Error> {
+        let shift = if let Formulation::Baumgarte { alpha, beta } = self.form {
+            self.velocity_terms(t)?;
+            let mh = self.info.nh();
+            let c = self.ws.constraints();
+            for (i, s) in self.shift.iter_mut().enumerate() {
+                let position = if i < mh { beta * beta * c[i] } else { 0.0 };
+                *s = -2.0 * alpha * self.vel[i] - position;
+            }
+            Some(&self.shift[..])
+        } else {
+            None
+        };
+        self.factorizations += 1;
+        self.dynamics.accelerations_shifted(
+            self.mech,
+            &mut self.ws,
+            t,
+            &self.q,
+            &self.qd,
+            shift,
+            &mut self.qdd,
+            &mut self.lambda,
+        )?;
+        Ok(())
+    }
+
+    /// Evaluates $C$ (in the workspace) and the velocity-level residuals
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$ (in `vel`) at the full state.
+    fn velocity_terms(&mut self, t: f64) -> Result<(), EvalError> {
+        let info = self.info;
+        let mh = info.nh();
+        self.ws.eval_constraints(self.mech, t, &self.q)?;
+        self.ws.eval_jacobian_values(self.mech, t, &self.q)?;
+        self.ws.eval_rates(self.mech, t, &self.q)?;
+        self.vel[..mh].copy_from_slice(&self.ws.ct);
+        self.vel[mh..].copy_from_slice(&self.ws.bias);
+        for (&(r, c), v) in info.holonomic_pattern.iter().zip(&self.ws.cq_values) {
+            self.vel[r as usize] += v * self.qd[c as usize];
+        }
+        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(&self.ws.g_values) {
+            self.vel[mh + r as usize] += v * self.qd[c as usize];
+        }
+        Ok(())
+    }
+
+    /// $(\lVert C\rVert_\infty, \lVert C_q\dot q + C_t\rVert_\infty,
+    /// \lVert G\dot q + g\rVert_\infty)$ at the full state.
+    pub fn violations(&mut self, t: f64) -> Result<(f64, f64, f64), EvalError> {
+        self.velocity_terms(t)?;
+        let mh = self.info.nh();
+        Ok((
+            inf_norm(self.ws.constraints()),
+            inf_norm(&self.vel[..mh]),
+            inf_norm(&self.vel[mh..]),
+        ))
+    }
+
+    /// Projection onto the constraint manifold: Newton with minimum-norm corrections
+    /// $\Delta q = -C_q^\mathsf{T}(C_q C_q^\mathsf{T})^{-1}C$ on the positions, then
+    /// $\dot q \leftarrow \dot q - J^\mathsf{T}(J J^\mathsf{T})^{-1}(J\dot q + [C_t; g])$.
+    pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let info = self.info;
+        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        let newton = self.kin.params().newton;
+        let eval = |e: EvalError| SimErrorKind::from_eval(e);
+        if mh > 0 {
+            let mut iterations = 0;
+            loop {
+                self.ws
+                    .eval_constraints(self.mech, t, &self.q)
+                    .map_err(eval)?;
+                let residual = inf_norm(self.ws.constraints());
+                let bound = newton.tolerance * (1.0 + inf_norm(&self.q));
+                if residual <= bound {
+                    break;
+                }
+                if iterations == newton.max_iterations || !residual.is_finite() {
+                    return Err(SimErrorKind::NewtonFailed {
+                        t,
+                        iterations,
+                        residual,
+                        constraints: self.violated(bound),
+                    });
+                }
+                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, mh, n);
+                if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+                    return Err(SimErrorKind::Singular {
+                        t,
+                        matrix: SingularMatrix::Projection,
+                        ratio,
+                        constraints: self.violated(bound),
+                    });
+                }
+                self.mu[..mh].copy_from_slice(self.ws.constraints());
+                self.lu_h.solve_vec(&mut self.mu[..mh]);
+                for i in 0..mh {
+                    let row = &self.ws.jacobian[i * n..(i + 1) * n];
+                    for (qj, a) in self.q.iter_mut().zip(row) {
+                        *qj -= a * self.mu[i];
+                    }
+                }
+                iterations += 1;
+                self.newton_iterations += 1;
+                self.factorizations += 1;
+            }
+        }
+        if m > 0 {
+            self.velocity_terms(t).map_err(eval)?;
+            self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, m, n);
+            self.factorizations += 1;
+            if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+                return Err(SimErrorKind::Singular {
+                    t,
+                    matrix: SingularMatrix::Projection,
+                    ratio,
+                    constraints: Vec::new(),
+                });
+            }
+            self.mu.copy_from_slice(&self.vel);
+            self.lu_v.solve_vec(&mut self.mu);
+            for i in 0..m {
+                let row = &self.ws.jacobian[i * n..(i + 1) * n];
+                for (v, a) in self.qd.iter_mut().zip(row) {
+                    *v -= a * self.mu[i];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn violated(&self, bound: f64) -> Vec<&'static str> {
+        self.ws
+            .constraints()
+            .iter()
+            .zip(self.info.holonomic)
+            .filter(|(c, _)| c.is_nan() || c.abs() > bound)
+            .map(|(_, s)| s.name)
+            .collect()
+    }
+
+    fn rhs_inner(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
+        self.reconstruct(t, y)?;
+        self.accelerations(t)?;
+        match self.form {
+            Formulation::Partitioning => {
+                dy.fill(0.0);
+                let np = self.coords.len();
+                for (k, &j) in self.coords.iter().enumerate() {
+                    dy[k] = self.qd[j];
+                }
+                for (k, &j) in self.gamma.iter().enumerate() {
+                    dy[np + k] = self.qdd[j];
+                }
+            }
+            _ => {
+                let n = self.q.len();
+                dy[..n].copy_from_slice(&self.qd);
+                dy[n..].copy_from_slice(&self.qdd);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes $A A^\mathsf{T}$ of the first `rows` rows of the dense row-major `a`
+/// (`rows × n`) into `lu`, factors it and returns the pivot ratio.
+fn gram(lu: &mut DenseLu, a: &[f64], rows: usize, n: usize) -> f64 {
+    {
+        let mut g = lu.matrix_mut();
+        for i in 0..rows {
+            let ri = &a[i * n..(i + 1) * n];
+            for k in 0..=i {
+                let rk = &a[k * n..(k + 1) * n];
+                let v: f64 = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
+                g[(i, k)] = v;
+                g[(k, i)] = v;
+            }
+        }
+    }
+    lu.factor().ratio()
+}
+
+impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        self.rhs_inner(t, y, dy).map_err(RhsError::new)
+    }
+}

@@ -1,0 +1,140 @@
+//! Typed failures, each with the partial run.
+
+use pfaff::sim::{Formulation, Method, NonFiniteSource, SimErrorKind, Simulation};
+use pfaff::{AssemblyError, KinematicsError, Mechanism, Quantity};
+use pfaff_models::pendulum;
+
+use super::models::{flywheel_crank, fragile_pendulum};
+
+#[test]
+fn inconsistent_initial_condition_is_an_assembly_error() {
+    let model = pendulum::Model::default();
+    // x = 2 with a link of length 1: no y satisfies x² + y² = 1.
+    let err = Simulation::new(&model)
+        .prescribe_coordinate("x", 2.0)
+        .run(1.0)
+        .unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::Assembly(AssemblyError::Partition(_))
+        ),
+        "{err}"
+    );
+    assert!(err.partial.trajectory.is_empty());
+    // The free slider-crank with the slider prescribed beyond the reach a + b = 0.4:
+    // x3 stays independent and Newton cannot meet the loop constraints.
+    let crank = flywheel_crank::Model::default();
+    let err = Simulation::new(&crank)
+        .prescribe_coordinate("x3", 0.5)
+        .run(1.0)
+        .unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::Assembly(AssemblyError::Kinematics(
+                KinematicsError::NewtonFailed { .. } | KinematicsError::SingularDependent { .. }
+            ))
+        ),
+        "{err}"
+    );
+    let err = Simulation::new(&model)
+        .prescribe_coordinate("theta", 0.0)
+        .run(1.0)
+        .unwrap_err();
+    assert!(matches!(
+        err.kind,
+        SimErrorKind::Assembly(AssemblyError::UnknownCoordinate { .. })
+    ));
+    let err = Simulation::new(&model)
+        .initial_state(&[1.0], &[0.0, 0.0])
+        .run(1.0)
+        .unwrap_err();
+    assert!(matches!(
+        err.kind,
+        SimErrorKind::InitialLength { found: 1, .. }
+    ));
+}
+
+#[test]
+fn nan_parameter_is_a_non_finite_error() {
+    let mut model = pendulum::Model::default();
+    let l = model.info().parameter_index("l").unwrap();
+    model.set_parameter(l, f64::NAN);
+    let err = Simulation::new(&model).run(1.0).unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::NonFinite {
+                t: 0.0,
+                source_of: NonFiniteSource::Model { .. }
+            }
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn nan_during_the_run_keeps_the_partial_trajectory() {
+    let model = fragile_pendulum::Model::default();
+    for form in Formulation::ALL {
+        let err = Simulation::new(&model)
+            .formulation(form)
+            .integrator(Method::Dopri5)
+            .tolerances(1e-8, 1e-10)
+            .output_every(0.01)
+            .run(2.0)
+            .unwrap_err();
+        eprintln!("{:<12} {err}", form.name());
+        let SimErrorKind::NonFinite { t, source_of } = err.kind else {
+            panic!("{form:?}: {err}");
+        };
+        assert!(matches!(
+            source_of,
+            NonFiniteSource::Model {
+                quantity: Quantity::Forces,
+                ..
+            }
+        ));
+        // The bob, released at y = 0, reaches y = -0.5 (θ = 60° from the horizontal)
+        // well within the first quarter period (0.59 s).
+        assert!(t > 0.1 && t < 0.6, "{t}");
+        let tr = &err.partial.trajectory;
+        assert!(tr.len() > 10);
+        let y = tr.coordinate("y").unwrap();
+        assert!(y.iter().all(|v| v.is_finite() && *v > -0.5), "{y:?}");
+    }
+}
+
+#[test]
+fn step_limit_is_a_max_steps_error_with_the_partial_run() {
+    let model = pendulum::Model::default();
+    let err = Simulation::new(&model)
+        .integrator(Method::Rk4 { h: 1e-3 })
+        .max_steps(100)
+        .run(1.0)
+        .unwrap_err();
+    assert!(
+        matches!(err.kind, SimErrorKind::MaxSteps { steps: 100, .. }),
+        "{err}"
+    );
+    // A row at the start and one per accepted step.
+    assert_eq!(err.partial.stats.steps, 100);
+    assert_eq!(err.partial.trajectory.len(), 101);
+    assert!((err.t().unwrap() - 0.1).abs() < 1e-12);
+}
+
+#[test]
+fn invalid_times_are_rejected() {
+    let model = pendulum::Model::default();
+    for (out, t_end) in [(vec![0.5, 0.2], 1.0), (vec![2.0], 1.0), (vec![], -1.0)] {
+        let err = Simulation::new(&model)
+            .output_times(&out)
+            .run(t_end)
+            .unwrap_err();
+        assert!(
+            matches!(err.kind, SimErrorKind::InvalidTimes { .. }),
+            "{err}"
+        );
+    }
+}

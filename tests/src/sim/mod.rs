@@ -1,0 +1,14 @@
+//! Simulation tests (`pfaff::sim`) on the built-in models and on a few models written
+//! for these tests with `#[pfaff::mechanism]`.
+//!
+//! Every reference value cites its source: math-spec.md (cases V10, V11),
+//! benchmark-models.md (the pendulum's exact solution), or a closed form derived in the
+//! test.
+
+mod exact;
+mod faults;
+mod models;
+mod pendulum;
+mod robustness;
+mod sleigh;
+mod slider_crank;
