@@ -17,6 +17,7 @@
 //!   sparse, with minimum-norm multipliers for redundant constraints.
 //! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
 //!   [`ode::OdeSystem`], with dense output, restarts and statistics.
+//! - [`linearize()`]: the linearized reduced system and its eigenvalues.
 //! - [`Error`]: every module's error, joined.
 
 pub use pfaff_macros::mechanism;
@@ -27,6 +28,7 @@ mod error;
 mod ext;
 mod kinematics;
 mod linalg;
+mod linearize;
 mod mechanism;
 pub mod ode;
 mod partition;
@@ -40,6 +42,9 @@ pub use dynamics::{
 pub use error::Error;
 pub use ext::{DerivativeCheck, MechanismExt, Residuals};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
+pub use linearize::{
+    linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
+};
 pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
 pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Workspace};

@@ -5,4 +5,6 @@
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod cli;
+#[cfg(test)]
 mod ui;
