@@ -48,9 +48,14 @@ pub fn suggestion<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>)
         .into_iter()
         .map(|c| (distance(name, c), c))
         .filter(|&(d, _)| d <= limit)
-        .min_by_key(|&(d, _)| d)
+        // Ties go to the longest common prefix (`c1` is nearer `c0` than `m1`).
+        .min_by_key(|&(d, c)| (d, usize::MAX - prefix(name, c)))
         .map(|(_, c)| format!(", did you mean `{c}`?"))
         .unwrap_or_default()
+}
+
+fn prefix(a: &str, b: &str) -> usize {
+    a.chars().zip(b.chars()).take_while(|(x, y)| x == y).count()
 }
 
 /// Levenshtein distance.
@@ -81,6 +86,7 @@ mod tests {
             ", did you mean `andrews`?"
         );
         assert_eq!(suggestion("zzz", ["pendulum", "andrews"]), "");
+        assert_eq!(suggestion("c1", ["m1", "c0"]), ", did you mean `c0`?");
         assert_eq!(suggestion("c", ["c0", "m1"]), ", did you mean `c0`?");
     }
 }

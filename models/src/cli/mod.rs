@@ -77,9 +77,29 @@ fn one_line(e: &clap::Error) -> String {
     lines.join("; ").trim_start_matches("error: ").to_owned()
 }
 
+/// Joins `--flag -1e-6` into `--flag=-1e-6`: clap takes `-1e-6` for a short option
+/// (its negative-number check does not cover exponents), and a negative value should
+/// reach the validation that explains what is expected.
+fn join_negative_values(args: impl Iterator<Item = String>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for arg in args {
+        let negative = arg.len() > 1
+            && arg.starts_with('-')
+            && arg[1..].starts_with(|c: char| c.is_ascii_digit() || c == '.');
+        match out.last_mut() {
+            Some(prev) if negative && prev.starts_with("--") && !prev.contains('=') => {
+                prev.push('=');
+                prev.push_str(&arg);
+            }
+            _ => out.push(arg),
+        }
+    }
+    out
+}
+
 /// Runs the program.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match Cli::try_parse_from(join_negative_values(std::env::args())) {
         Ok(cli) => cli,
         Err(e) => {
             if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
