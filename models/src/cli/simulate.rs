@@ -107,8 +107,8 @@ pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outc
             // Only runs that last show a bar (indicatif hides it when stderr is not a
             // terminal).
             if start.elapsed() > Duration::from_millis(300) {
-                shown.set_position((t / t_end * 1000.0) as u64);
                 shown.set_message(format!("{t:.4e}"));
+                shown.set_position((t / t_end * 1000.0) as u64);
             }
         });
     if let (Some(h), false) = (req.args.step, matches!(req.method, Method::Rk4 { .. })) {
@@ -244,13 +244,14 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     let entry = pfaff_models::find(info.name);
     let _ = writeln!(w, "{}: {}", info.name, entry.map_or("", |e| e.summary));
     let dof = info.nq() - info.nh();
+    let dof = dof - info.nnh().min(dof);
     let _ = writeln!(
         w,
-        "  {} coordinates, {} holonomic and {} non-holonomic constraints ({} degrees of freedom)",
+        "  {} coordinates, {} holonomic and {} non-holonomic constraints ({dof} degree{} of freedom)",
         info.nq(),
         info.nh(),
         info.nnh(),
-        dof - info.nnh().min(dof)
+        if dof == 1 { "" } else { "s" }
     );
     let tol = match req.method {
         Method::Rk4 { h } => format!("fixed step {h:e} s"),
@@ -387,6 +388,9 @@ pub fn report(
     }
     if req.args.json {
         println!("{}", json_report(model, req, out));
+        for note in &out.notes {
+            eprintln!("pfaff: note: {note}");
+        }
     } else {
         print!("{}", summary(model, req, scene, out));
         for note in &out.notes {
