@@ -2,9 +2,13 @@
 //!
 //! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
+pub mod sources;
+
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
 mod cli;
+#[cfg(test)]
+mod snapshots;
 #[cfg(test)]
 mod ui;
