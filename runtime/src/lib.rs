@@ -20,6 +20,7 @@
 //! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
 //!   partitioning, projection or Baumgarte stabilization, any integrator, output at
 //!   requested times, monitors and work-precision sweeps.
+//! - [`linearize()`]: the linearized reduced system and its eigenvalues.
 //! - [`Error`]: every module's error, joined.
 
 pub use pfaff_macros::mechanism;
@@ -30,6 +31,7 @@ mod error;
 mod ext;
 mod kinematics;
 mod linalg;
+mod linearize;
 mod mechanism;
 pub mod ode;
 mod partition;
@@ -44,6 +46,9 @@ pub use dynamics::{
 pub use error::Error;
 pub use ext::{DerivativeCheck, MechanismExt, Residuals};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
+pub use linearize::{
+    linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
+};
 pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
 pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Workspace};

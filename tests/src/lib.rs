@@ -7,6 +7,8 @@ pub mod sources;
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod cli;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;

@@ -1,0 +1,119 @@
+//! `pfaff linearize`: eigenvalues of the linearized reduced system about a state, by
+//! [`pfaff::linearize`].
+
+use std::fmt::Write as _;
+
+use pfaff::{linearize, LinearizeParams};
+use serde_json::json;
+
+use super::args::LinearizeArgs;
+use super::error::{failed, usage, CliError};
+use super::scene::Scene;
+use super::setup;
+
+/// `pfaff linearize`.
+pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(&args.model)?;
+    let model = setup::build(entry, &args.state.set)?;
+    let scene = Scene::of(entry.name);
+    let mut guesses: Vec<(&str, f64)> = Vec::new();
+    let mut velocities: Vec<(&str, f64)> = Vec::new();
+    let mut ignorable: &[&str] = &[];
+    let mut about = "the initial state".to_owned();
+    if let Some(steady) = scene.steady {
+        guesses.extend(steady.coordinates);
+        velocities.extend(steady.velocities);
+        ignorable = steady.ignorable;
+        about = steady.summary.to_owned();
+        if let Some((coordinate, default)) = steady.speed {
+            let v = args.speed.unwrap_or(default);
+            if !v.is_finite() {
+                return Err(usage(format!(
+                    "invalid --speed {v}: expected a finite number"
+                )));
+            }
+            velocities.push((coordinate, v));
+            about = format!("{about} at speed {v}");
+        }
+    }
+    if args.speed.is_some() && scene.steady.and_then(|s| s.speed).is_none() {
+        return Err(usage(format!(
+            "model `{}` defines no steady forward motion, so --speed does not apply (it does for: sleigh)",
+            entry.name
+        )));
+    }
+    // The steady motion's values are guesses; --q0/--qd0 are held (and win).
+    let init = setup::assemble(model.as_ref(), &args.state, &guesses, &velocities)?;
+    let lin = linearize(
+        model.as_ref(),
+        0.0,
+        &init.q,
+        &init.qd,
+        ignorable,
+        &LinearizeParams::default(),
+    )
+    .map_err(|e| failed(format!("cannot linearize `{}`: {e}", entry.name)))?;
+    let d = lin.states.len();
+    let rows: Vec<Vec<f64>> = (0..d)
+        .map(|i| (0..d).map(|j| lin.entry(i, j)).collect())
+        .collect();
+    if args.json {
+        let value = json!({
+            "model": entry.name,
+            "states": lin.states.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            "eigenvalues": lin.eigenvalues.iter().map(|e| json!({"re": e.re, "im": e.im})).collect::<Vec<_>>(),
+            "state_matrix": rows,
+            "error_estimate": lin.error_estimate,
+        });
+        println!("{value}");
+        return Ok(());
+    }
+    let mut w = String::new();
+    let _ = writeln!(w, "{} linearized about {} (t = 0)", entry.name, about);
+    let point: Vec<String> = model
+        .info()
+        .coordinates
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            format!(
+                "{} = {:.6}, {}' = {:.6}",
+                c.name, lin.q[i], c.name, lin.qd[i]
+            )
+        })
+        .collect();
+    let _ = writeln!(w, "operating point  {}", point.join("; "));
+    let [beta, eta, gamma] = &lin.partition;
+    let _ = writeln!(
+        w,
+        "partition        dependent {beta:?}, dependent velocity {eta:?}, independent {gamma:?}"
+    );
+    if !ignorable.is_empty() {
+        let _ = writeln!(
+            w,
+            "dropped          {ignorable:?} (ignorable; largest coupling into the kept rows {:.1e})",
+            lin.dropped_coupling
+        );
+    }
+    let names: Vec<String> = lin.states.iter().map(ToString::to_string).collect();
+    let _ = writeln!(w, "state            ({})", names.join(", "));
+    let _ = writeln!(w, "state matrix");
+    for row in &rows {
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:>14.6e}")).collect();
+        let _ = writeln!(w, "  {}", cells.join(" "));
+    }
+    let _ = writeln!(w, "eigenvalues");
+    for e in &lin.eigenvalues {
+        let _ = writeln!(w, "  {:>16.9e} {:+.9e} i", e.re, e.im);
+    }
+    let _ = writeln!(
+        w,
+        "difference error estimate max|A_h - A_2h| = {:.1e}",
+        lin.error_estimate
+    );
+    for note in &init.notes {
+        let _ = writeln!(w, "note             {note}");
+    }
+    print!("{w}");
+    Ok(())
+}

@@ -1,0 +1,99 @@
+//! `pfaff work-precision`: every formulation × integrator over a tolerance sweep, by
+//! [`pfaff::sim::work_precision`], against a closed form where the model has one and
+//! otherwise against a run at rtol 1e-13 with partitioning and DOP853.
+
+use pfaff::sim::{format_table, work_precision, Formulation, Method, Reference, Simulation, Sweep};
+
+use super::args::WorkPrecisionArgs;
+use super::error::{failed, usage, CliError};
+use super::scene::Scene;
+use super::{plot, setup};
+
+/// `pfaff work-precision`.
+pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(&args.model)?;
+    let model = (entry.make)();
+    let scene = Scene::of(entry.name);
+    let t_end = args.t_end.unwrap_or(scene.t_end);
+    if !t_end.is_finite() || t_end <= 0.0 {
+        return Err(usage(format!(
+            "--t-end {t_end} is not after the start time 0: expected a positive finite end time"
+        )));
+    }
+    let (reference, source) = match scene.closed_form {
+        Some(exact) => {
+            let mut r = Reference::default();
+            for (name, q, qd) in exact(model.as_ref(), t_end) {
+                if q.is_finite() {
+                    r.coordinates.push((name.to_owned(), q));
+                }
+                if qd.is_finite() {
+                    r.velocities.push((name.to_owned(), qd));
+                }
+            }
+            (r, "the closed-form solution".to_owned())
+        }
+        None => {
+            let run = Simulation::new(model.as_ref())
+                .formulation(Formulation::Partitioning)
+                .integrator(Method::Dop853)
+                .tolerances(1e-13, 1e-15)
+                .output_times(&[])
+                .run(t_end)
+                .map_err(|e| {
+                    failed(format!(
+                        "the reference run of `{}` failed: {}",
+                        entry.name, e.kind
+                    ))
+                })?;
+            (
+                Reference::from_run(&run),
+                "a run at rtol 1e-13, atol 1e-15 (partitioning + dop853)".to_owned(),
+            )
+        }
+    };
+    let rows = work_precision(model.as_ref(), &Sweep::standard(t_end), &reference);
+    println!(
+        "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference|, reference: {source}",
+        entry.name
+    );
+    print!("{}", format_table(&rows));
+    if let Some(path) = &args.csv {
+        let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
+        let mut w = csv::Writer::from_path(path).map_err(io)?;
+        w.write_record([
+            "formulation",
+            "method",
+            "rtol",
+            "error",
+            "rhs_evals",
+            "steps",
+            "repartitions",
+            "wall_seconds",
+            "failure",
+        ])
+        .map_err(io)?;
+        for r in &rows {
+            w.write_record([
+                r.formulation.name().to_owned(),
+                r.method.name().to_owned(),
+                r.rtol.to_string(),
+                r.error.to_string(),
+                r.rhs_evals.to_string(),
+                r.steps.to_string(),
+                r.repartitions.to_string(),
+                r.wall_time.as_secs_f64().to_string(),
+                r.failure.clone().unwrap_or_default(),
+            ])
+            .map_err(io)?;
+        }
+        w.flush()
+            .map_err(|e| failed(format!("cannot write `{}`: {e}", path.display())))?;
+        println!("table  {}", path.display());
+    }
+    if let Some(path) = &args.plot {
+        plot::work_precision(entry.name, t_end, &rows, path)?;
+        println!("plot   {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,236 @@
+//! What the program knows about each built-in model beyond its `Info`: a sensible time
+//! span, the steady motion to linearize about, and closed-form solutions used as the
+//! reference of `pfaff work-precision`.
+//!
+//! Input: a model name. Output: a [`Scene`]; models without an entry get
+//! [`Scene::fallback`] (span 1 s, no steady motion, no closed form).
+
+use pfaff::Mechanism;
+
+/// The reference solution of a model at time `t`: `(coordinates, velocities)` by name.
+pub type ClosedForm = fn(&dyn Mechanism, f64) -> Vec<(&'static str, f64, f64)>;
+
+/// A steady motion: coordinates set (the rest assembled), the coordinate whose velocity
+/// is the forward speed, and the coordinates that are ignorable in that motion.
+#[derive(Clone, Copy, Debug)]
+pub struct Steady {
+    /// `(name, value)` of coordinates held at the operating point.
+    pub coordinates: &'static [(&'static str, f64)],
+    /// `(name, value)` of velocities at the operating point, besides the speed.
+    pub velocities: &'static [(&'static str, f64)],
+    /// The coordinate whose velocity `--speed` sets, and its default.
+    pub speed: Option<(&'static str, f64)>,
+    /// Ignorable coordinates, dropped from the state matrix.
+    pub ignorable: &'static [&'static str],
+    /// What the steady motion is, for the report.
+    pub summary: &'static str,
+}
+
+/// Program-level knowledge of one model.
+#[derive(Clone, Copy, Debug)]
+pub struct Scene {
+    /// Default end time of `simulate` [s].
+    pub t_end: f64,
+    /// Why that span.
+    pub span: &'static str,
+    /// The default operating point of `linearize`.
+    pub steady: Option<Steady>,
+    /// Exact solution from the default initial state, when there is one.
+    pub closed_form: Option<ClosedForm>,
+}
+
+impl Scene {
+    /// The scene of a model without an entry.
+    pub const fn fallback() -> Self {
+        Self {
+            t_end: 1.0,
+            span: "1 s",
+            steady: None,
+            closed_form: None,
+        }
+    }
+
+    /// The scene of the model called `name`.
+    pub fn of(name: &str) -> Self {
+        match name {
+            "pendulum" => Self {
+                // Three periods 4K(1/2)√(l/g) = 2.36784194757624 s.
+                t_end: 7.103_525_842_728_72,
+                span: "three periods",
+                steady: Some(Steady {
+                    coordinates: &[("x", 0.0), ("y", -1.0)],
+                    velocities: &[],
+                    speed: None,
+                    ignorable: &[],
+                    summary: "hanging at rest",
+                }),
+                closed_form: Some(pendulum_exact),
+            },
+            "slider_crank" => Self {
+                t_end: std::f64::consts::TAU / 10.0,
+                span: "one crank revolution",
+                steady: None,
+                closed_form: None,
+            },
+            "andrews" => Self {
+                t_end: 0.03,
+                span: "the reference span of Hairer & Wanner",
+                steady: None,
+                closed_form: None,
+            },
+            "car_axis" => Self {
+                t_end: 3.0,
+                span: "the reference span",
+                steady: None,
+                closed_form: None,
+            },
+            "sleigh" => Self {
+                t_end: 5.0,
+                span: "the span of math-spec V11",
+                steady: Some(Steady {
+                    coordinates: &[("x", 0.0), ("y", 0.0), ("phi", 0.0)],
+                    velocities: &[("phi", 0.0)],
+                    speed: Some(("x", 1.0)),
+                    ignorable: &["x", "y", "phi"],
+                    summary: "straight motion along x",
+                }),
+                closed_form: Some(sleigh_exact),
+            },
+            "seed2_example1" => Self {
+                t_end: 2.0,
+                span: "the span of math-spec V2",
+                steady: None,
+                closed_form: Some(seed2_example1_exact),
+            },
+            "seed2_example2" => Self {
+                t_end: 1.0,
+                span: "the span of math-spec V4",
+                steady: None,
+                closed_form: None,
+            },
+            _ => Self::fallback(),
+        }
+    }
+}
+
+fn parameter(model: &dyn Mechanism, name: &str) -> f64 {
+    let info = model.info();
+    info.parameter_index(name)
+        .map_or(f64::NAN, |i| model.parameter(i))
+}
+
+/// The pendulum released at rest from x = l, y = 0 (benchmark-models.md): with θ from
+/// the downward vertical, sin(θ/2) = k sn(K − ω0 t | 1/2), k = 1/√2, ω0 = √(g/l).
+fn pendulum_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
+    const K: f64 = 1.854_074_677_301_371_9;
+    let (l, g) = (parameter(model, "l"), parameter(model, "g"));
+    let w0 = (g / l).sqrt();
+    let k = std::f64::consts::FRAC_1_SQRT_2;
+    let (sn, cn, dn) = jacobi(K - w0 * t, 0.5);
+    let s = k * sn; // sin(θ/2)
+    let c = (1.0 - s * s).sqrt(); // cos(θ/2) ≥ 0 since |θ| ≤ π/2
+    let theta = 2.0 * s.atan2(c);
+    let theta_dot = -2.0 * k * w0 * cn * dn / c;
+    vec![
+        ("x", l * theta.sin(), l * theta.cos() * theta_dot),
+        ("y", -l * theta.cos(), l * theta.sin() * theta_dot),
+    ]
+}
+
+/// Jacobi's sn, cn, dn of `u` for the parameter `m` (0 ≤ m < 1), by the descending
+/// Landen transformation (arithmetic–geometric mean; Abramowitz & Stegun 16.4).
+pub fn jacobi(u: f64, m: f64) -> (f64, f64, f64) {
+    let mut a = [1.0_f64; 16];
+    let mut c = [0.0_f64; 16];
+    let mut b = (1.0 - m).sqrt();
+    c[0] = m.sqrt();
+    let mut n = 0;
+    while n < 15 && c[n].abs() > f64::EPSILON {
+        a[n + 1] = 0.5 * (a[n] + b);
+        c[n + 1] = 0.5 * (a[n] - b);
+        b = (a[n] * b).sqrt();
+        n += 1;
+    }
+    let mut phi = f64::powi(2.0, n as i32) * a[n] * u;
+    for j in (1..=n).rev() {
+        phi = 0.5 * (phi + (c[j] / a[j] * phi.sin()).asin());
+    }
+    let (sn, cn) = phi.sin_cos();
+    (sn, cn, (1.0 - m * sn * sn).sqrt())
+}
+
+/// The Chaplygin sleigh of math-spec V11 from its default state (forward speed v0 = 1,
+/// turning rate ω0 = 0.5 at φ = 0): v = V tanh(kt + c), ω = √(m/J) V sech(kt + c),
+/// φ = (√(J/m)/a)(gd(kt + c) − gd(c)), with J = ic + m a², V² = v0² + J ω0²/m,
+/// k = a m V/J, c = artanh(v0/V), gd the Gudermannian. Positions x, y need a quadrature,
+/// so only φ and the velocities are compared.
+fn sleigh_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
+    let (m, ic, a) = (
+        parameter(model, "m"),
+        parameter(model, "ic"),
+        parameter(model, "a"),
+    );
+    let mut q0 = [0.0; 3];
+    let mut qd0 = [0.0; 3];
+    model.initial_state(&mut q0, &mut qd0);
+    let (v0, w0) = (qd0[0], qd0[2]);
+    let j = ic + m * a * a;
+    let big_v = (v0 * v0 + j * w0 * w0 / m).sqrt();
+    let k = a * m * big_v / j;
+    let c = (v0 / big_v).atanh();
+    let s = k * t + c;
+    let gd = |x: f64| x.sinh().atan();
+    let v = big_v * s.tanh();
+    let w = (m / j).sqrt() * big_v / s.cosh();
+    let phi = (j / m).sqrt() / a * (gd(s) - gd(c));
+    let (sp, cp) = phi.sin_cos();
+    vec![
+        ("x", f64::NAN, v * cp - a * w * sp),
+        ("y", f64::NAN, v * sp + a * w * cp),
+        ("phi", phi, w),
+    ]
+}
+
+/// math-spec V2: q = (1 + t, t − t²/2, t).
+fn seed2_example1_exact(_: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
+    vec![
+        ("q1", 1.0 + t, 1.0),
+        ("q2", t - 0.5 * t * t, 1.0 - t),
+        ("q3", t, 1.0),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobi_matches_known_values() {
+        // sn(K(1/2) | 1/2) = 1, cn = 0, dn = 1/√2.
+        let (sn, cn, dn) = jacobi(1.854_074_677_301_371_9, 0.5);
+        assert!((sn - 1.0).abs() < 1e-15 && cn.abs() < 1e-8);
+        assert!((dn - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15);
+        // m = 0: circular functions.
+        let (sn, cn, _) = jacobi(0.7, 0.0);
+        assert!((sn - 0.7f64.sin()).abs() < 1e-15 && (cn - 0.7f64.cos()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn sleigh_matches_math_spec_v11() {
+        let entry = pfaff_models::find("sleigh").unwrap();
+        let model = (entry.make)();
+        for (t, phi) in [(1.0, 0.176_360_706_663), (5.0, 0.189_860_567_654)] {
+            let found = sleigh_exact(model.as_ref(), t)[2].1;
+            assert!((found - phi).abs() < 1e-11, "{found} vs {phi}");
+        }
+    }
+
+    #[test]
+    fn pendulum_period() {
+        let model = (pfaff_models::find("pendulum").unwrap().make)();
+        let at_start = pendulum_exact(model.as_ref(), 2.367_841_947_576_24);
+        assert!((at_start[0].1 - 1.0).abs() < 1e-10 && at_start[1].1.abs() < 1e-6);
+        let bottom = pendulum_exact(model.as_ref(), 2.367_841_947_576_24 / 4.0);
+        assert!(bottom[0].1.abs() < 1e-12 && (bottom[1].1 + 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,413 @@
+//! `pfaff simulate` and the default scene: run a simulation, then report it as a short
+//! summary or one JSON object, and optionally as CSV rows and an SVG plot.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pfaff::sim::{Formulation, Method, Run, SimErrorKind, Simulation};
+use pfaff::{Mechanism, MechanismExt};
+use serde_json::{json, Map, Value};
+
+use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
+use super::error::{failed, usage, CliError};
+use super::scene::Scene;
+use super::{plot, setup};
+
+/// A validated simulation request.
+pub struct Request<'a> {
+    pub args: &'a SimulateArgs,
+    pub t_end: f64,
+    pub formulation: Formulation,
+    pub method: Method,
+}
+
+fn formulation(f: FormulationArg) -> Formulation {
+    match f {
+        FormulationArg::Partitioning => Formulation::Partitioning,
+        FormulationArg::Projection => Formulation::Projection,
+        FormulationArg::Baumgarte => Formulation::baumgarte(),
+    }
+}
+
+fn positive(flag: &str, v: f64, allow_zero: bool) -> Result<(), CliError> {
+    if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) {
+        Ok(())
+    } else {
+        let what = if allow_zero {
+            "a non-negative"
+        } else {
+            "a positive"
+        };
+        Err(usage(format!(
+            "invalid {flag} {v}: expected {what} finite number"
+        )))
+    }
+}
+
+/// Checks the numbers of `args` and picks the defaults.
+pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>, CliError> {
+    positive("--rtol", args.rtol, false)?;
+    positive("--atol", args.atol, true)?;
+    let t_end = args.t_end.unwrap_or(scene.t_end);
+    if !t_end.is_finite() || t_end <= 0.0 {
+        return Err(usage(format!(
+            "--t-end {t_end} is not after the start time 0: expected a positive finite end time"
+        )));
+    }
+    if let Some(h) = args.step {
+        positive("--step", h, false)?;
+    }
+    if args.samples == 0 {
+        return Err(usage("invalid --samples 0: expected at least 1"));
+    }
+    let method = match args.integrator {
+        IntegratorArg::Rk4 => Method::Rk4 {
+            h: args.step.unwrap_or(t_end / 1000.0),
+        },
+        IntegratorArg::Dopri5 => Method::Dopri5,
+        IntegratorArg::Dop853 => Method::Dop853,
+        IntegratorArg::Adams => Method::Adams,
+    };
+    Ok(Request {
+        args,
+        t_end,
+        formulation: formulation(args.formulation),
+        method,
+    })
+}
+
+/// A finished (or failed) simulation with what the reports need.
+pub struct Outcome {
+    pub run: Run,
+    pub error: Option<SimErrorKind>,
+    pub wall: Duration,
+    pub notes: Vec<String>,
+}
+
+/// Runs the simulation of `req` on `model`.
+pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outcome, CliError> {
+    let init = setup::assemble(model, &req.args.state, &[], &[])?;
+    let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} t = {msg} s [{bar:40}] {percent}% ({elapsed})")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let start = Instant::now();
+    let t_end = req.t_end;
+    let shown = bar.clone();
+    let mut sim = Simulation::new(model)
+        .formulation(req.formulation)
+        .integrator(req.method)
+        .tolerances(req.args.rtol, req.args.atol)
+        .initial_state(&init.q, &init.qd)
+        .on_progress(move |t| {
+            // Only runs that last show a bar (indicatif hides it when stderr is not a
+            // terminal).
+            if start.elapsed() > Duration::from_millis(300) {
+                shown.set_message(format!("{t:.4e}"));
+                shown.set_position((t / t_end * 1000.0) as u64);
+            }
+        });
+    if let (Some(h), false) = (req.args.step, matches!(req.method, Method::Rk4 { .. })) {
+        sim = sim.initial_step(h);
+    }
+    sim = if dense {
+        sim.output_every(t_end / req.args.samples as f64)
+    } else {
+        sim.output_times(&[])
+    };
+    let result = sim.run(t_end);
+    drop(sim);
+    bar.finish_and_clear();
+    let wall = start.elapsed();
+    Ok(match result {
+        Ok(run) => Outcome {
+            run,
+            error: None,
+            wall,
+            notes: init.notes,
+        },
+        Err(e) => Outcome {
+            run: *e.partial,
+            error: Some(e.kind),
+            wall,
+            notes: init.notes,
+        },
+    })
+}
+
+/// The `kind` of a failure in the JSON report.
+fn kind_name(kind: &SimErrorKind) -> &'static str {
+    match kind {
+        SimErrorKind::InvalidTimes { .. } => "invalid_times",
+        SimErrorKind::InitialLength { .. } => "initial_length",
+        SimErrorKind::Assembly(_) => "assembly",
+        SimErrorKind::NewtonFailed { .. } => "newton_failed",
+        SimErrorKind::Singular { .. } => "singular",
+        SimErrorKind::StepSizeTooSmall { .. } => "step_size_too_small",
+        SimErrorKind::MaxSteps { .. } => "max_steps",
+        SimErrorKind::NonFinite { .. } => "non_finite",
+        SimErrorKind::Analysis(_) => "analysis",
+        SimErrorKind::Integrator(_) => "integrator",
+    }
+}
+
+fn named(names: impl Iterator<Item = &'static str>, values: &[f64]) -> Value {
+    Value::Object(
+        names
+            .zip(values)
+            .map(|(n, &v)| (n.to_owned(), json!(v)))
+            .collect::<Map<_, _>>(),
+    )
+}
+
+/// Energies at the first and last rows, when the model conserves energy.
+fn energies(model: &dyn Mechanism, run: &Run) -> Option<(f64, f64)> {
+    let m = &run.monitors;
+    match (m.energy_initial, m.energy_final) {
+        (Some(a), Some(b)) => Some((a, b)),
+        _ if model.info().conservative && !run.trajectory.is_empty() => {
+            let tr = &run.trajectory;
+            let last = tr.len() - 1;
+            Some((
+                model.energy(tr.t[0], tr.q(0), tr.qd(0)),
+                model.energy(tr.t[last], tr.q(last), tr.qd(last)),
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// The JSON report (see the README for its keys).
+pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> Value {
+    let info = model.info();
+    let run = &out.run;
+    let constraints = info
+        .holonomic
+        .iter()
+        .chain(info.nonholonomic)
+        .map(|s| s.name);
+    let last = run.trajectory.len().checked_sub(1);
+    let final_ = last.map_or(Value::Null, |i| {
+        let tr = &run.trajectory;
+        json!({
+            "t": tr.t[i],
+            "q": named(info.coordinates.iter().map(|s| s.name), tr.q(i)),
+            "qd": named(info.coordinates.iter().map(|s| s.name), tr.qd(i)),
+            "lambda": named(constraints, tr.lambda(i)),
+        })
+    });
+    let s = &run.stats;
+    let m = &run.monitors;
+    let mut obj = json!({
+        "model": info.name,
+        "formulation": req.formulation.name(),
+        "integrator": req.method.name(),
+        "rtol": req.args.rtol,
+        "atol": req.args.atol,
+        "t_end": req.t_end,
+        "final": final_,
+        "stats": {
+            "steps": s.steps,
+            "rejected": s.rejected,
+            "rhs_evals": s.rhs_evals,
+            "newton_iterations": s.newton_iterations,
+            "factorizations": s.factorizations,
+            "repartitions": s.repartitions,
+        },
+        "max_violation": {
+            "position": m.max_position_violation,
+            "velocity": m.max_velocity_violation.max(m.max_nonholonomic_violation),
+        },
+        "energy": energies(model, run).map_or(Value::Null, |(a, b)| json!({"initial": a, "final": b})),
+        "wall_seconds": out.wall.as_secs_f64(),
+    });
+    if let Some(kind) = &out.error {
+        obj["error"] = json!({
+            "kind": kind_name(kind),
+            "message": kind.to_string(),
+            "t": kind.t(),
+        });
+    }
+    obj
+}
+
+/// The human summary.
+pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Outcome) -> String {
+    let info = model.info();
+    let run = &out.run;
+    let (s, m) = (&run.stats, &run.monitors);
+    let mut w = String::new();
+    let entry = pfaff_models::find(info.name);
+    let _ = writeln!(w, "{}: {}", info.name, entry.map_or("", |e| e.summary));
+    let dof = info.nq() - info.nh();
+    let dof = dof - info.nnh().min(dof);
+    let _ = writeln!(
+        w,
+        "  {} coordinates, {} holonomic and {} non-holonomic constraints ({dof} degree{} of freedom)",
+        info.nq(),
+        info.nh(),
+        info.nnh(),
+        if dof == 1 { "" } else { "s" }
+    );
+    let tol = match req.method {
+        Method::Rk4 { h } => format!("fixed step {h:e} s"),
+        _ => format!("rtol {:e}, atol {:e}", req.args.rtol, req.args.atol),
+    };
+    let span = if req.args.t_end.is_some() {
+        ""
+    } else {
+        scene.span
+    };
+    let _ = writeln!(
+        w,
+        "method       {} + {}, {tol}",
+        req.formulation.name(),
+        req.method.name()
+    );
+    let reached = run.final_state().map_or(0.0, |f| f.0);
+    let _ = writeln!(
+        w,
+        "span         0 to {} s{}{}",
+        req.t_end,
+        if span.is_empty() {
+            String::new()
+        } else {
+            format!(" ({span})")
+        },
+        if out.error.is_some() {
+            format!(", stopped at {reached} s")
+        } else {
+            String::new()
+        }
+    );
+    let _ = writeln!(
+        w,
+        "work         {} steps ({} rejected), {} rhs evaluations, {} Newton iterations, {} factorizations, {} re-partitions",
+        s.steps, s.rejected, s.rhs_evals, s.newton_iterations, s.factorizations, s.repartitions
+    );
+    let _ = writeln!(w, "wall time    {:.3} ms", out.wall.as_secs_f64() * 1e3);
+    let _ = writeln!(
+        w,
+        "violations   position {:.2e}, velocity {:.2e}{}",
+        m.max_position_violation,
+        m.max_velocity_violation,
+        if info.nnh() > 0 {
+            format!(", non-holonomic {:.2e}", m.max_nonholonomic_violation)
+        } else {
+            String::new()
+        }
+    );
+    match (energies(model, run), m.max_energy_drift) {
+        (Some((a, b)), drift) => {
+            let _ = writeln!(
+                w,
+                "energy       {a:.10e} -> {b:.10e} J, drift {:.2e} (largest {:.2e})",
+                b - a,
+                drift.unwrap_or((b - a).abs())
+            );
+        }
+        (None, _) => {
+            let _ = writeln!(
+                w,
+                "energy       not conserved (applied forces or explicit time): no drift to report"
+            );
+        }
+    }
+    if let Some((t, q, _)) = run.final_state() {
+        let list: Vec<String> = info
+            .coordinates
+            .iter()
+            .zip(q)
+            .map(|(c, v)| format!("{} = {v:.6}", c.name))
+            .collect();
+        let _ = writeln!(w, "final        t = {t}: {}", list.join(", "));
+    }
+    w
+}
+
+/// Writes the CSV of the trajectory: `t`, the coordinates, the velocities (`NAME'`),
+/// the multipliers (`lambda_NAME`), `position_violation`, `velocity_violation` and
+/// `energy`.
+pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), CliError> {
+    let info = model.info();
+    let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
+    let mut w = csv::Writer::from_path(path).map_err(io)?;
+    let mut header = vec!["t".to_owned()];
+    header.extend(info.coordinates.iter().map(|c| c.name.to_owned()));
+    header.extend(info.coordinates.iter().map(|c| format!("{}'", c.name)));
+    header.extend(
+        info.holonomic
+            .iter()
+            .chain(info.nonholonomic)
+            .map(|c| format!("lambda_{}", c.name)),
+    );
+    header.extend(["position_violation", "velocity_violation", "energy"].map(String::from));
+    w.write_record(&header).map_err(io)?;
+    let tr = &run.trajectory;
+    for i in 0..tr.len() {
+        let mut rec: Vec<String> = vec![tr.t[i].to_string()];
+        rec.extend(tr.q(i).iter().map(f64::to_string));
+        rec.extend(tr.qd(i).iter().map(f64::to_string));
+        rec.extend(tr.lambda(i).iter().map(f64::to_string));
+        rec.push(tr.position_violation[i].to_string());
+        rec.push(tr.velocity_violation[i].to_string());
+        rec.push(model.energy(tr.t[i], tr.q(i), tr.qd(i)).to_string());
+        w.write_record(&rec).map_err(io)?;
+    }
+    w.flush()
+        .map_err(|e| failed(format!("cannot write `{}`: {e}", path.display())))
+}
+
+/// `pfaff simulate`.
+pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(&args.model)?;
+    let model = setup::build(entry, &args.state.set)?;
+    let scene = Scene::of(entry.name);
+    let req = request(args, &scene)?;
+    let dense = args.csv.is_some() || args.plot.is_some();
+    let out = run(model.as_ref(), &req, dense)?;
+    report(model.as_ref(), &req, &scene, &out)
+}
+
+/// Prints the report of `out` and writes the requested files.
+pub fn report(
+    model: &dyn Mechanism,
+    req: &Request<'_>,
+    scene: &Scene,
+    out: &Outcome,
+) -> Result<(), CliError> {
+    if let Some(path) = &req.args.csv {
+        write_csv(model, &out.run, path)?;
+    }
+    if let Some(path) = &req.args.plot {
+        plot::trajectory(model, &out.run, path)?;
+    }
+    if req.args.json {
+        println!("{}", json_report(model, req, out));
+        for note in &out.notes {
+            eprintln!("pfaff: note: {note}");
+        }
+    } else {
+        print!("{}", summary(model, req, scene, out));
+        for note in &out.notes {
+            println!("note         {note}");
+        }
+        if let Some(path) = &req.args.csv {
+            println!("trajectory   {}", path.display());
+        }
+        if let Some(path) = &req.args.plot {
+            println!("plot         {}", path.display());
+        }
+    }
+    match &out.error {
+        Some(kind) => Err(failed(format!(
+            "simulation of `{}` failed: {kind}",
+            model.info().name
+        ))),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,389 @@
+//! The `pfaff` binary, command by command: what a user sees and what scripts parse.
+
+mod common;
+
+use common::{assert_svg, pfaff, pfaff_in, scratch, stderr, stdout};
+use serde_json::Value;
+
+#[test]
+fn default_scene_simulates_andrews_and_writes_a_plot() {
+    let dir = scratch("default_scene");
+    let out = pfaff_in(&dir, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    for needle in [
+        "andrews:",
+        "partitioning + adams",
+        "rhs evaluations",
+        "Newton iterations",
+        "re-partitions",
+        "wall time",
+        "violations",
+        "energy",
+        "pfaff-andrews.svg",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}` in\n{text}");
+    }
+    assert_svg(&dir.join("pfaff-andrews.svg"));
+}
+
+#[test]
+fn list_shows_every_model_with_its_sizes() {
+    let out = pfaff(&["list"]);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    for entry in pfaff_models::all() {
+        let line = text
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(entry.name))
+            .unwrap_or_else(|| panic!("`{}` not listed", entry.name));
+        assert!(line.contains(entry.summary), "{line}");
+    }
+    let sleigh = text.lines().find(|l| l.starts_with("sleigh ")).unwrap();
+    let cols: Vec<&str> = sleigh.split_whitespace().take(5).collect();
+    assert_eq!(cols, ["sleigh", "3", "0", "1", "0"]);
+    let andrews = text.lines().find(|l| l.starts_with("andrews ")).unwrap();
+    let cols: Vec<&str> = andrews.split_whitespace().take(5).collect();
+    assert_eq!(cols, ["andrews", "7", "6", "0", "0"]);
+}
+
+#[test]
+fn show_lists_coordinates_parameters_and_constraints() {
+    let out = pfaff(&["show", "andrews"]);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    for needle in [
+        "beta",
+        "epsilon",
+        "c0",
+        "4530",
+        "mom",
+        "holonomic constraints (6)",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}`");
+    }
+}
+
+/// Every key of the JSON summary, as documented.
+fn check_keys(v: &Value, with_error: bool) {
+    let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    let mut expected = vec![
+        "atol",
+        "energy",
+        "final",
+        "formulation",
+        "integrator",
+        "max_violation",
+        "model",
+        "rtol",
+        "stats",
+        "t_end",
+        "wall_seconds",
+    ];
+    if with_error {
+        expected.push("error");
+    }
+    expected.sort_unstable();
+    assert_eq!(keys, expected);
+    let mut stats: Vec<&str> = v["stats"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    stats.sort_unstable();
+    assert_eq!(
+        stats,
+        [
+            "factorizations",
+            "newton_iterations",
+            "rejected",
+            "repartitions",
+            "rhs_evals",
+            "steps"
+        ]
+    );
+    let mut viol: Vec<&str> = v["max_violation"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    viol.sort_unstable();
+    assert_eq!(viol, ["position", "velocity"]);
+}
+
+#[test]
+fn simulate_json_is_one_object_with_the_documented_keys() {
+    let out = pfaff(&[
+        "simulate",
+        "pendulum",
+        "--t-end",
+        "1",
+        "--integrator",
+        "dop853",
+        "--rtol",
+        "1e-9",
+        "--atol",
+        "1e-11",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert_eq!(text.trim().lines().count(), 1, "{text}");
+    let v: Value = serde_json::from_str(&text).unwrap();
+    check_keys(&v, false);
+    assert_eq!(v["model"], "pendulum");
+    assert_eq!(v["formulation"], "partitioning");
+    assert_eq!(v["integrator"], "dop853");
+    assert_eq!(v["rtol"], 1e-9);
+    assert_eq!(v["t_end"], 1.0);
+    let fin = &v["final"];
+    assert_eq!(fin["t"], 1.0);
+    let mut keys: Vec<&str> = fin
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort_unstable();
+    assert_eq!(keys, ["lambda", "q", "qd", "t"]);
+    let (x, y) = (
+        fin["q"]["x"].as_f64().unwrap(),
+        fin["q"]["y"].as_f64().unwrap(),
+    );
+    assert!((x * x + y * y - 1.0).abs() < 1e-9);
+    assert!(fin["lambda"]["rod"].is_f64());
+    assert!(v["stats"]["steps"].as_u64().unwrap() > 0);
+    let e = &v["energy"];
+    let drift = e["final"].as_f64().unwrap() - e["initial"].as_f64().unwrap();
+    assert!(drift.abs() < 1e-5, "{drift}");
+    assert!(v["wall_seconds"].as_f64().unwrap() >= 0.0);
+}
+
+#[test]
+fn simulate_energy_is_null_for_a_driven_model() {
+    let out = pfaff(&["simulate", "andrews", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    check_keys(&v, false);
+    assert!(v["energy"].is_null());
+    // Hairer & Wanner's reference: beta(0.03) = 15.81155...
+    let beta = v["final"]["q"]["beta"].as_f64().unwrap();
+    assert!((beta - 15.81).abs() < 0.01, "{beta}");
+}
+
+#[test]
+fn simulate_failure_reports_the_error_and_the_partial_run() {
+    // A massless sleigh: the augmented matrix is singular from the start.
+    let out = pfaff(&[
+        "simulate", "sleigh", "--set", "m=0", "--set", "ic=0", "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("singular"), "{err}");
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    check_keys(&v, true);
+    let mut keys: Vec<&str> = v["error"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort_unstable();
+    assert_eq!(keys, ["kind", "message", "t"]);
+    assert_eq!(v["error"]["kind"], "singular");
+    assert_eq!(v["error"]["t"], 0.0);
+}
+
+#[test]
+fn simulate_writes_csv_and_plot() {
+    let dir = scratch("csv_plot");
+    let out = pfaff_in(
+        &dir,
+        &[
+            "simulate",
+            "andrews",
+            "--samples",
+            "50",
+            "--csv",
+            "a.csv",
+            "--plot",
+            "a.svg",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(dir.join("a.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    // t, 7 q, 7 q', 6 lambda, 2 residuals, energy.
+    assert_eq!(header.len(), 1 + 7 + 7 + 6 + 3);
+    assert_eq!(header[0], "t");
+    assert_eq!(header[1], "beta");
+    assert_eq!(header[8], "beta'");
+    assert!(header[15].starts_with("lambda_"));
+    assert_eq!(
+        &header[21..],
+        ["position_violation", "velocity_violation", "energy"]
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 51);
+    assert!(rows.iter().all(|r| r.len() == header.len()));
+    assert_eq!(rows[0][0], 0.0);
+    assert!((rows[50][0] - 0.03).abs() < 1e-15);
+    assert!(rows.iter().all(|r| r[21] < 1e-10));
+    assert_svg(&dir.join("a.svg"));
+}
+
+#[test]
+fn simulate_holds_prescribed_initial_values() {
+    // x prescribed; y follows from the link (y = -sqrt(1 - 0.36)), started below.
+    let out = pfaff(&[
+        "simulate", "pendulum", "--t-end", "0.5", "--q0", "x=0.6", "--q0", "y=-0.9", "--set",
+        "l=1", "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert!(v["final"]["q"]["x"].as_f64().unwrap().abs() < 0.6);
+}
+
+#[test]
+fn every_formulation_and_integrator_runs() {
+    for f in ["partitioning", "projection", "baumgarte"] {
+        for i in ["rk4", "dopri5", "dop853", "adams"] {
+            let out = pfaff(&[
+                "simulate",
+                "sleigh",
+                "--formulation",
+                f,
+                "--integrator",
+                i,
+                "--t-end",
+                "1",
+                "--json",
+            ]);
+            assert!(out.status.success(), "{f} {i}: {}", stderr(&out));
+            let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+            assert_eq!(
+                (v["formulation"].as_str(), v["integrator"].as_str()),
+                (Some(f), Some(i))
+            );
+            // math-spec V11 at t = 1: phi = 0.176360706663.
+            let phi = v["final"]["q"]["phi"].as_f64().unwrap();
+            assert!((phi - 0.176_360_706_663).abs() < 1e-3, "{f} {i}: {phi}");
+        }
+    }
+}
+
+#[test]
+fn linearize_pendulum_json() {
+    let out = pfaff(&[
+        "linearize",
+        "pendulum",
+        "--q0",
+        "x=0",
+        "--q0",
+        "y=-1",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let eig = v["eigenvalues"].as_array().unwrap();
+    assert_eq!(eig.len(), 2);
+    let w = 9.81f64.sqrt();
+    for (e, sign) in eig.iter().zip([-1.0, 1.0]) {
+        assert!(e["re"].as_f64().unwrap().abs() < 1e-7 * w);
+        assert!((e["im"].as_f64().unwrap() - sign * w).abs() < 1e-7 * w);
+    }
+    let a = v["state_matrix"].as_array().unwrap();
+    assert_eq!(a.len(), 2);
+    assert!(a.iter().all(|r| r.as_array().unwrap().len() == 2));
+}
+
+#[test]
+fn linearize_sleigh_at_a_speed() {
+    let out = pfaff(&["linearize", "sleigh", "--speed", "3", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let re: Vec<f64> = v["eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["re"].as_f64().unwrap())
+        .collect();
+    let (m, ic, a, speed) = (2.0, 0.05, 0.3, 3.0);
+    let decay = -m * a * speed / (ic + m * a * a);
+    assert!((re[0] - decay).abs() < 1e-7 * decay.abs(), "{re:?}");
+    assert!(re[1].abs() < 1e-7, "{re:?}");
+    let text = stdout(&pfaff(&["linearize", "sleigh", "--speed", "3"]));
+    assert!(
+        text.contains("eigenvalues") && text.contains("dropped"),
+        "{text}"
+    );
+}
+
+#[test]
+fn work_precision_table_csv_and_plot() {
+    let dir = scratch("work_precision");
+    let out = pfaff_in(
+        &dir,
+        &[
+            "work-precision",
+            "seed2_example1",
+            "--t-end",
+            "1",
+            "--csv",
+            "wp.csv",
+            "--plot",
+            "wp.svg",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("closed-form"), "{text}");
+    for f in ["partitioning", "projection", "baumgarte"] {
+        for i in ["rk4", "dopri5", "dop853", "adams"] {
+            assert!(
+                text.lines().any(|l| l.starts_with(f) && l.contains(i)),
+                "no {f} {i} row in\n{text}"
+            );
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("wp.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "formulation,method,rtol,error,rhs_evals,steps,repartitions,wall_seconds,failure"
+    );
+    assert_eq!(csv.lines().count(), 1 + 3 * 4 * 10);
+    assert_svg(&dir.join("wp.svg"));
+}
+
+#[test]
+fn progress_bar_stays_hidden_when_stderr_is_not_a_terminal() {
+    // Long enough (well over the 0.3 s before a bar appears) with stderr piped.
+    let out = pfaff(&[
+        "simulate",
+        "pendulum",
+        "--t-end",
+        "2000",
+        "--integrator",
+        "dop853",
+        "--rtol",
+        "1e-10",
+        "--atol",
+        "1e-12",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert!(
+        v["wall_seconds"].as_f64().unwrap() > 0.3,
+        "run too short to test the bar"
+    );
+    assert_eq!(stderr(&out), "");
+}

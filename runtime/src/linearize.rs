@@ -1,0 +1,424 @@
+//! Linearization of the reduced (independent-state) equations of motion.
+//!
+//! Input: a model, an operating point $(q, \dot q, t)$, and optionally the names of
+//! coordinates that are ignorable in the motion studied (the position and heading of a
+//! sleigh running straight). Output: the state matrix $A = \partial f/\partial y$ of the
+//! reduced system $\dot y = f(y)$ and its eigenvalues.
+//!
+//! **Reduced state.** Coordinate partitioning (Algorithm P) splits
+//! $q = [\beta; \eta; \gamma]$. The independent state is
+//! $y = [p;\ \dot\gamma]$ with $p = [\eta; \gamma]$, of dimension
+//! $(n - m_h) + (n - m_h - m_{nh})$. For a perturbed $y$, the map
+//! $f$ solves K1 for $\beta$ (Newton started from the operating point), K2 for
+//! $[\dot\beta; \dot\eta]$, the augmented system (E31) for $\ddot q$, and returns
+//! $f(y) = [\dot\eta;\ \dot\gamma;\ \ddot\gamma]$. The partition is computed once, at the
+//! operating point, keeping the ignorable coordinates independent.
+//!
+//! **Ignorable coordinates.** Their rows and columns are removed from $A$. If the
+//! remaining rows do not depend on them (a cyclic coordinate, or a derivative that
+//! vanishes at the operating point), $A$ is block triangular and the dropped
+//! eigenvalues are exactly the zeros of the removed block, so the eigenvalues returned
+//! are the ones that remain. [`Linearization::dropped_coupling`] reports
+//! $\max |\partial f_w/\partial c|$ over the kept rows $w$ and dropped columns $c$, so a
+//! caller can see whether the removal was legitimate.
+//!
+//! **Difference step.** Column $j$ of $A$ is the central difference
+//! $(f(y + h_j e_j) - f(y - h_j e_j)) / 2h_j$ with
+//! $h_j = \varepsilon^{1/3}(1 + |y_j|)$, $\varepsilon$ = [`f64::EPSILON`]
+//! (so $h_j \approx 6\cdot10^{-6}$ for unit-sized states). The truncation error is
+//! $h_j^2 |f'''|/6 \approx 6\cdot10^{-12}|f'''|$ and the rounding error
+//! $\approx \varepsilon |f| / h_j \approx 4\cdot10^{-11}|f|$; $\varepsilon^{1/3}$ balances
+//! the two. K1 runs to a relative tolerance of $10^{-14}$ so that Newton's residual
+//! error ($\lesssim 10^{-14}/h_j \approx 2\cdot10^{-9}$ relative at worst, in practice
+//! far smaller since Newton converges quadratically) stays below both. The matrix is
+//! also computed with the steps $2h_j$; [`Linearization::error_estimate`] is
+//! $\max |A_h - A_{2h}|$, which is three times the truncation error of $A_h$ when that
+//! dominates. Eigenvalues of a non-defective $A$ move by at most
+//! $\kappa(V)\,\lVert\delta A\rVert$ ($V$ the eigenvectors; Bauer–Fike).
+
+use crate::dynamics::{Dynamics, DynamicsError, DynamicsParams};
+use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams};
+use crate::partition::{Partition, PartitionError, PartitionParams, Preferences};
+use crate::workspace::{check_state, EvalError, Workspace};
+use crate::Mechanism;
+
+/// Tuning of [`linearize`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearizeParams {
+    /// Relative difference step $h_j / (1 + |y_j|)$; default $\varepsilon^{1/3}$.
+    pub relative_step: f64,
+    /// Position and velocity analysis (the default Newton tolerance is $10^{-14}$).
+    pub kinematics: KinematicsParams,
+    /// The acceleration solve.
+    pub dynamics: DynamicsParams,
+}
+
+impl Default for LinearizeParams {
+    fn default() -> Self {
+        Self {
+            relative_step: f64::EPSILON.cbrt(),
+            kinematics: KinematicsParams {
+                newton: NewtonParams {
+                    tolerance: 1e-14,
+                    max_iterations: 50,
+                },
+                partition: PartitionParams::default(),
+            },
+            dynamics: DynamicsParams::default(),
+        }
+    }
+}
+
+/// An eigenvalue $\lambda = \mathrm{re} + i\,\mathrm{im}$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Eigenvalue {
+    /// Real part.
+    pub re: f64,
+    /// Imaginary part.
+    pub im: f64,
+}
+
+/// One component of the reduced state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StateComponent {
+    /// The coordinate.
+    pub coordinate: &'static str,
+    /// `false` for the coordinate itself, `true` for its velocity.
+    pub velocity: bool,
+}
+
+impl std::fmt::Display for StateComponent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}{}",
+            self.coordinate,
+            if self.velocity { "'" } else { "" }
+        )
+    }
+}
+
+/// The linearized reduced system $\delta\dot y = A\,\delta y$ at an operating point.
+#[derive(Clone, Debug)]
+pub struct Linearization {
+    /// The reduced state, in the order of the rows and columns of the state matrix.
+    pub states: Vec<StateComponent>,
+    /// $A$ (row-major, `states.len()` squared).
+    pub state_matrix: Vec<f64>,
+    /// Eigenvalues of $A$, sorted by real part, then imaginary part.
+    pub eigenvalues: Vec<Eigenvalue>,
+    /// $\max |A_h - A_{2h}|$ (see the module docs).
+    pub error_estimate: f64,
+    /// $\max |\partial f_w / \partial c|$ over kept rows and dropped coordinates (0 when
+    /// nothing is dropped).
+    pub dropped_coupling: f64,
+    /// The partition used: names of $\beta$, $\eta$, $\gamma$.
+    pub partition: [Vec<&'static str>; 3],
+    /// The operating point after K1/K2 (coordinates).
+    pub q: Vec<f64>,
+    /// The operating point after K1/K2 (velocities).
+    pub qd: Vec<f64>,
+}
+
+impl Linearization {
+    /// $A_{ij}$.
+    #[must_use]
+    pub fn entry(&self, i: usize, j: usize) -> f64 {
+        self.state_matrix[i * self.states.len() + j]
+    }
+}
+
+/// Errors of [`linearize`].
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LinearizeError {
+    /// An ignorable name is not a coordinate of the model.
+    #[error("unknown coordinate `{name}` among the ignorable ones, expected one of {expected:?}")]
+    UnknownCoordinate {
+        /// The name given.
+        name: String,
+        /// The model's coordinates.
+        expected: Vec<&'static str>,
+    },
+    /// An ignorable coordinate is dependent at the operating point.
+    #[error("ignorable coordinate `{name}` cannot be kept independent: {source}")]
+    DependentIgnorable {
+        /// The name given.
+        name: &'static str,
+        /// Why.
+        source: PartitionError,
+    },
+    /// The relative difference step is not a positive finite number.
+    #[error("invalid relative difference step {0:e}, expected a positive finite value")]
+    InvalidStep(f64),
+    /// Algorithm P failed.
+    #[error(transparent)]
+    Partition(#[from] PartitionError),
+    /// K1 or K2 failed at a perturbed state.
+    #[error(transparent)]
+    Kinematics(#[from] KinematicsError),
+    /// The acceleration solve failed.
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+    /// Evaluation failed.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+    /// The eigenvalue decomposition did not converge.
+    #[error("eigenvalue decomposition of the {dim}x{dim} state matrix did not converge")]
+    Eigen {
+        /// Dimension of $A$.
+        dim: usize,
+    },
+}
+
+/// The reduced map $f(y)$ and its scratch.
+struct Reduced<'a, M: Mechanism + ?Sized> {
+    mech: &'a M,
+    t: f64,
+    ws: Workspace,
+    kin: Kinematics,
+    dynamics: Dynamics,
+    /// Operating point (the Newton start of every evaluation).
+    q0: Vec<f64>,
+    qd0: Vec<f64>,
+    /// $p = [\eta; \gamma]$ (indices into $q$).
+    p: Vec<usize>,
+    /// $\gamma$.
+    gamma: Vec<usize>,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    lambda: Vec<f64>,
+}
+
+impl<M: Mechanism + ?Sized> Reduced<'_, M> {
+    fn state(&self) -> Vec<f64> {
+        let mut y: Vec<f64> = self.p.iter().map(|&i| self.q0[i]).collect();
+        y.extend(self.gamma.iter().map(|&i| self.qd0[i]));
+        y
+    }
+
+    /// Writes $f(y)$ into `out`.
+    fn eval(&mut self, y: &[f64], out: &mut [f64]) -> Result<(), LinearizeError> {
+        let np = self.p.len();
+        self.q.copy_from_slice(&self.q0);
+        self.qd.copy_from_slice(&self.qd0);
+        for (k, &i) in self.p.iter().enumerate() {
+            self.q[i] = y[k];
+        }
+        for (k, &i) in self.gamma.iter().enumerate() {
+            self.qd[i] = y[np + k];
+        }
+        self.kin
+            .position(self.mech, &mut self.ws, self.t, &mut self.q)?;
+        self.kin
+            .velocity(self.mech, &mut self.ws, self.t, &self.q, &mut self.qd)?;
+        self.dynamics.accelerations(
+            self.mech,
+            &mut self.ws,
+            self.t,
+            &self.q,
+            &self.qd,
+            &mut self.qdd,
+            &mut self.lambda,
+        )?;
+        // ṗ = [η̇; γ̇], then γ̈.
+        for (k, &i) in self.p.iter().enumerate() {
+            out[k] = self.qd[i];
+        }
+        for (k, &i) in self.gamma.iter().enumerate() {
+            out[np + k] = self.qdd[i];
+        }
+        Ok(())
+    }
+
+    /// Central-difference Jacobian with steps `scale` × $h_j$ (row-major).
+    fn jacobian(&mut self, y0: &[f64], rel: f64, scale: f64) -> Result<Vec<f64>, LinearizeError> {
+        let d = y0.len();
+        let mut a = vec![0.0; d * d];
+        let (mut fp, mut fm) = (vec![0.0; d], vec![0.0; d]);
+        let mut y = y0.to_vec();
+        for j in 0..d {
+            let h = scale * rel * (1.0 + y0[j].abs());
+            // Use the representable step so that the divisor matches the perturbation.
+            let (yp, ym) = (y0[j] + h, y0[j] - h);
+            y[j] = yp;
+            self.eval(&y, &mut fp)?;
+            y[j] = ym;
+            self.eval(&y, &mut fm)?;
+            y[j] = y0[j];
+            for i in 0..d {
+                a[i * d + j] = (fp[i] - fm[i]) / (yp - ym);
+            }
+        }
+        Ok(a)
+    }
+}
+
+/// Linearizes the reduced equations of motion at $(q, \dot q, t)$.
+///
+/// The dependent parts of $(q, \dot q)$ are first recomputed from the independent ones
+/// (K1, K2), so a point that is consistent to the usual tolerances is made exact. The
+/// coordinates named in `ignorable` are kept independent and their rows and columns are
+/// removed (their velocities stay). See the module docs for the state, the step and the
+/// error.
+///
+/// # Errors
+/// An unknown or dependent ignorable coordinate, a failure of partitioning, of K1/K2 or
+/// of the acceleration solve at a perturbed state, or an eigensolver failure.
+///
+/// ```
+/// use pfaff::{linearize, LinearizeParams};
+/// # #[pfaff::mechanism]
+/// # pub mod pendulum {
+/// #     const m: f64 = 1.0;
+/// #     const l: f64 = 1.0;
+/// #     const g: f64 = 9.81;
+/// #     static x: Coordinate = Coordinate { q0: l, qd0: 0.0 };
+/// #     static y: Coordinate = Coordinate {};
+/// #     fn kinetic_energy() -> f64 { 0.5 * m * (x.dot().powi(2) + y.dot().powi(2)) }
+/// #     fn potential_energy() -> f64 { m * g * y }
+/// #     #[holonomic]
+/// #     fn rod() -> f64 { x.powi(2) + y.powi(2) - l.powi(2) }
+/// # }
+/// // The pendulum hanging at rest: δẍ = −(g/l) δx, eigenvalues ±i√(g/l).
+/// let model = pendulum::Model::default();
+/// let lin = linearize(&model, 0.0, &[0.0, -1.0], &[0.0, 0.0], &[], &LinearizeParams::default())?;
+/// assert_eq!(lin.states.len(), 2);
+/// assert!((lin.eigenvalues[1].im - 9.81f64.sqrt()).abs() < 1e-7);
+/// # Ok::<(), pfaff::LinearizeError>(())
+/// ```
+pub fn linearize<M: Mechanism + ?Sized>(
+    mech: &M,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    ignorable: &[&str],
+    params: &LinearizeParams,
+) -> Result<Linearization, LinearizeError> {
+    let info = mech.info();
+    check_state(info, t, q, Some(qd))?;
+    let rel = params.relative_step;
+    if !(rel.is_finite() && rel > 0.0) {
+        return Err(LinearizeError::InvalidStep(rel));
+    }
+    let dropped: Vec<usize> = ignorable
+        .iter()
+        .map(|&name| {
+            info.coordinate_index(name)
+                .ok_or_else(|| LinearizeError::UnknownCoordinate {
+                    name: name.to_owned(),
+                    expected: info.coordinates.iter().map(|s| s.name).collect(),
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut ws = Workspace::new(info)?;
+    let prefs = Preferences {
+        coordinates: &dropped,
+        velocities: &[],
+    };
+    let partition = Partition::compute(mech, &mut ws, t, q, prefs, &params.kinematics.partition)
+        .map_err(|e| match e {
+            PartitionError::PrescribedCoordinate { coordinate, .. } => {
+                LinearizeError::DependentIgnorable {
+                    name: coordinate,
+                    source: e,
+                }
+            }
+            other => other.into(),
+        })?;
+    let names = partition.names();
+    let gamma = partition.independent().to_vec();
+    let p: Vec<usize> = partition
+        .dependent_velocity()
+        .iter()
+        .chain(&gamma)
+        .copied()
+        .collect();
+    let mut kin = Kinematics::new(info, params.kinematics);
+    kin.set_partition(partition);
+    let (mut q0, mut qd0) = (q.to_vec(), qd.to_vec());
+    kin.position(mech, &mut ws, t, &mut q0)?;
+    kin.velocity(mech, &mut ws, t, &q0, &mut qd0)?;
+    let n = info.nq();
+    let m = info.nh() + info.nnh();
+    let mut reduced = Reduced {
+        mech,
+        t,
+        ws,
+        kin,
+        dynamics: Dynamics::new(info, params.dynamics)?,
+        q: q0.clone(),
+        qd: qd0.clone(),
+        q0,
+        qd0,
+        p,
+        gamma,
+        qdd: vec![0.0; n],
+        lambda: vec![0.0; m],
+    };
+    let y0 = reduced.state();
+    let a_h = reduced.jacobian(&y0, rel, 1.0)?;
+    let a_2h = reduced.jacobian(&y0, rel, 2.0)?;
+    let error_estimate = a_h
+        .iter()
+        .zip(&a_2h)
+        .fold(0.0_f64, |e, (x, y)| e.max((x - y).abs()));
+
+    // Reduced state components; keep all but the dropped coordinates.
+    let mut all: Vec<StateComponent> = reduced
+        .p
+        .iter()
+        .map(|&i| StateComponent {
+            coordinate: info.coordinates[i].name,
+            velocity: false,
+        })
+        .collect();
+    all.extend(reduced.gamma.iter().map(|&i| StateComponent {
+        coordinate: info.coordinates[i].name,
+        velocity: true,
+    }));
+    let d = all.len();
+    let is_dropped = |k: usize| k < reduced.p.len() && dropped.contains(&reduced.p[k]);
+    let kept: Vec<usize> = (0..d).filter(|&k| !is_dropped(k)).collect();
+    let mut dropped_coupling = 0.0_f64;
+    for &i in &kept {
+        for j in (0..d).filter(|&j| is_dropped(j)) {
+            dropped_coupling = dropped_coupling.max(a_h[i * d + j].abs());
+        }
+    }
+    let dk = kept.len();
+    let state_matrix: Vec<f64> = kept
+        .iter()
+        .flat_map(|&i| kept.iter().map(move |&j| (i, j)))
+        .map(|(i, j)| a_h[i * d + j])
+        .collect();
+    let eigenvalues = eigenvalues(&state_matrix, dk)?;
+    Ok(Linearization {
+        states: kept.iter().map(|&k| all[k]).collect(),
+        state_matrix,
+        eigenvalues,
+        error_estimate,
+        dropped_coupling,
+        partition: names,
+        q: reduced.q0,
+        qd: reduced.qd0,
+    })
+}
+
+/// Eigenvalues of the dense row-major `d × d` matrix `a`, sorted by real part, then
+/// imaginary part.
+fn eigenvalues(a: &[f64], d: usize) -> Result<Vec<Eigenvalue>, LinearizeError> {
+    if d == 0 {
+        return Ok(Vec::new());
+    }
+    let mat = faer::Mat::<f64>::from_fn(d, d, |i, j| a[i * d + j]);
+    let values = mat
+        .eigenvalues()
+        .map_err(|_| LinearizeError::Eigen { dim: d })?;
+    let mut out: Vec<Eigenvalue> = values
+        .iter()
+        .map(|z| Eigenvalue { re: z.re, im: z.im })
+        .collect();
+    out.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    Ok(out)
+}
