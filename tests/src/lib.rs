@@ -5,4 +5,6 @@
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod free_motion;
+#[cfg(test)]
 mod ui;
