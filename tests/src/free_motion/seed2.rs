@@ -71,7 +71,10 @@ fn v3_example2_multipliers() {
     assert_close("R", &p.reaction, &[l, -l, -l], 1e-10);
     let r = augmented(ex2::Model::default(), 1.0, &q, &qd);
     assert_close("λ[S1]", &r.lambda, &[-l], 1e-10);
-    println!("V3: λ[S2] = {:.15}, relative error {err:.1e}", p.lambda_s2[0]);
+    println!(
+        "V3: λ[S2] = {:.15}, relative error {err:.1e}",
+        p.lambda_s2[0]
+    );
 }
 
 /// Exact motion of V2.
@@ -93,7 +96,14 @@ fn v2_designed_forces_simulated() {
         |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
             let (fm, ws) = &mut *fm.borrow_mut();
             let s = fm
-                .free_forces(&ex1::Model::default(), ws, t, q, qd, ForceDesign::Components(&[1]))
+                .free_forces(
+                    &ex1::Model::default(),
+                    ws,
+                    t,
+                    q,
+                    qd,
+                    ForceDesign::Components(&[1]),
+                )
                 .unwrap();
             assert!(s.exact);
             assert!((s.applied[1] + qd[0]).abs() <= 1e-15 * (1.0 + qd[0].abs()));
@@ -118,7 +128,13 @@ fn v2_designed_forces_simulated() {
     let mut ws = Workspace::new(&ex1::INFO).unwrap();
     let mut check = FreeMotion::new(&ex1::INFO, FreeMotionParams::default());
     let report = check
-        .check_along(&designed, &mut ws, samples(&run), AppliedForces::AsModeled, 1e-10)
+        .check_along(
+            &designed,
+            &mut ws,
+            samples(&run),
+            AppliedForces::AsModeled,
+            1e-10,
+        )
         .unwrap();
     assert!(report.free, "{report:?}");
     println!(
@@ -177,7 +193,10 @@ fn v2_v4_free_without_multipliers() {
         assert!((s.1[0] - 2.0 / (2.0 + t.sin())).abs() < 100.0 * TOL);
     }
     let mut worst_f = 0.0_f64;
-    for (m, run) in [(&ex1::Model::default() as &dyn Mechanism, &run), (&model, &run4)] {
+    for (m, run) in [
+        (&ex1::Model::default() as &dyn Mechanism, &run),
+        (&model, &run4),
+    ] {
         for s in run {
             let r = m.residuals(s.t, &s.q, &s.qd);
             worst_f = worst_f.max(r.position.max(r.velocity));
@@ -187,7 +206,13 @@ fn v2_v4_free_without_multipliers() {
     let mut ws = Workspace::new(&ex2::INFO).unwrap();
     let mut fm = FreeMotion::new(&ex2::INFO, FreeMotionParams::default());
     let report = fm
-        .check_along(&model, &mut ws, samples(&run4), AppliedForces::AsModeled, 1e-10)
+        .check_along(
+            &model,
+            &mut ws,
+            samples(&run4),
+            AppliedForces::AsModeled,
+            1e-10,
+        )
         .unwrap();
     assert!(report.free, "{report:?}");
     println!(
@@ -209,7 +234,14 @@ fn v4_designed_forces_simulated() {
         |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
             let (fm, ws) = &mut *fm.borrow_mut();
             let s = fm
-                .free_forces(&ex2::Model::default(), ws, t, q, qd, ForceDesign::Components(&[1]))
+                .free_forces(
+                    &ex2::Model::default(),
+                    ws,
+                    t,
+                    q,
+                    qd,
+                    ForceDesign::Components(&[1]),
+                )
                 .unwrap();
             out.copy_from_slice(&s.applied);
         },

@@ -119,7 +119,11 @@ pub fn simulate<M: Mechanism + ?Sized>(
             t,
             q: y[..n].to_vec(),
             qd: y[n..].to_vec(),
-            lambda: if constrained { sys.lambda.clone() } else { Vec::new() },
+            lambda: if constrained {
+                sys.lambda.clone()
+            } else {
+                Vec::new()
+            },
         });
     };
     record(&mut sys, t0, &y0);

@@ -20,8 +20,16 @@ fn point() -> FreeMotionPoint {
     let mut ws = Workspace::new(&v5::INFO).unwrap();
     let mut fm = FreeMotion::new(&v5::INFO, FreeMotionParams::default());
     let mut p = FreeMotionPoint::new(&v5::INFO);
-    fm.evaluate(&model, &mut ws, T, &Q, &QD, AppliedForces::AsModeled, &mut p)
-        .unwrap();
+    fm.evaluate(
+        &model,
+        &mut ws,
+        T,
+        &Q,
+        &QD,
+        AppliedForces::AsModeled,
+        &mut p,
+    )
+    .unwrap();
     p
 }
 
@@ -86,7 +94,12 @@ fn v5_matches_augmented_solve() {
     let da: Vec<f64> = p.qdd.iter().zip(&r.qdd).map(|(a, b)| a - b).collect();
     assert!(inf_norm(&dl) < 1e-14, "λ: {dl:?}");
     assert!(inf_norm(&da) < 1e-14, "q̈: {da:?}");
-    let s2: Vec<f64> = r.lambda_s2().iter().zip(&p.lambda_s2).map(|(a, b)| a - b).collect();
+    let s2: Vec<f64> = r
+        .lambda_s2()
+        .iter()
+        .zip(&p.lambda_s2)
+        .map(|(a, b)| a - b)
+        .collect();
     assert!(inf_norm(&s2) < 1e-14, "λ[S2]: {s2:?}");
     // The [S2] constraint force R = Fᵀλ[S2] is the total −Jᵀλ of the runtime.
     let total = r.total_force();

@@ -207,9 +207,7 @@ impl Printer<'_> {
                 }
                 wrap(s, SUM)
             }
-            Node::Powi(x, n) if *n > 0 => {
-                wrap(format!("{}^{n}", self.expr(*x, POWER + 1)), POWER)
-            }
+            Node::Powi(x, n) if *n > 0 => wrap(format!("{}^{n}", self.expr(*x, POWER + 1)), POWER),
             Node::Mul(_) | Node::Powi(_, _) => {
                 let (neg, body) = self.signed(e);
                 if neg {
