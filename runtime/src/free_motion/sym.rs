@@ -87,8 +87,8 @@ impl Eigen {
             }
             rank += 1;
             let proj: f64 = (0..m).map(|k| self.v[k * m + i] * b[k]).sum::<f64>() / mu;
-            for k in 0..m {
-                x[k] += proj * self.v[k * m + i];
+            for (k, xk) in x.iter_mut().enumerate().take(m) {
+                *xk += proj * self.v[k * m + i];
             }
         }
         rank

@@ -12,6 +12,7 @@
 mod models;
 mod sim;
 
+mod design;
 mod parallelogram;
 mod seed2;
 mod slider_crank;
