@@ -8,3 +8,7 @@ mod accuracy;
 mod free_motion;
 #[cfg(test)]
 mod ui;
+
+/// The chapter `docs/free-motion.md`; its code blocks run as doctests.
+#[doc = include_str!("../../docs/free-motion.md")]
+pub mod free_motion_chapter {}
