@@ -2,10 +2,14 @@
 //!
 //! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
+pub mod sources;
+
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
 mod free_motion;
+#[cfg(test)]
+mod snapshots;
 #[cfg(test)]
 mod ui;
 

@@ -20,6 +20,7 @@
 pub mod ctxt;
 pub mod derive;
 pub mod emit;
+pub mod measure;
 pub mod model;
 pub mod parse;
 pub mod sched;

@@ -1,0 +1,124 @@
+//! Measurements of the generator's output: operation counts of the emitted code against
+//! the naive expression trees, and a readable dump of every derived quantity.
+//!
+//! The *naive tree* is what differentiating the user's expressions gives with no
+//! simplification and no sharing: the same derivation run in a raw graph (which only
+//! hash-conses), with every output expanded as a tree. The *emitted* count is what the
+//! generated functions evaluate: canonical expressions with each shared node computed
+//! once per function.
+
+use std::fmt::Write;
+
+use proc_macro2::TokenStream;
+
+use crate::derive::{self, Derived, Entry};
+use crate::sym::{display, transform, ExprId, Graph, Var};
+use crate::{ctxt, model, parse, Analysis};
+
+/// Arithmetic operation counts of one model's generated functions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpCounts {
+    /// Operations of the outputs as trees, derived without simplification.
+    pub naive_tree: u128,
+    /// Operations of the simplified outputs as trees (simplification, no sharing).
+    pub simplified_tree: u128,
+    /// Operations of the emitted straight-line code (simplification and sharing).
+    pub emitted: u64,
+}
+
+/// The outputs of each generated function, in emission order.
+fn functions(d: &Derived) -> Vec<Vec<ExprId>> {
+    let e = |v: &[Entry]| v.iter().map(|e| e.expr).collect::<Vec<_>>();
+    vec![
+        e(&d.mass),
+        d.forces.clone(),
+        d.c.clone(),
+        e(&d.cq),
+        d.ct.clone(),
+        d.gamma_h.clone(),
+        e(&d.gm),
+        d.gb.clone(),
+        d.gamma_nh.clone(),
+        vec![d.kinetic],
+        vec![d.potential],
+    ]
+}
+
+/// Counts the operations of the model in `input` (a `#[mechanism]` module body).
+///
+/// # Errors
+/// The model's diagnostics, as the macro would report them.
+pub fn op_counts(args: TokenStream, input: TokenStream) -> syn::Result<OpCounts> {
+    let analysis = crate::analyze(args.clone(), input.clone())?;
+    let fns = functions(&analysis.derived);
+    let all: Vec<ExprId> = fns.iter().flatten().copied().collect();
+    let simplified_tree = transform::tree_op_count(&analysis.graph, &all);
+    let emitted = fns
+        .iter()
+        .map(|roots| transform::op_count(&analysis.graph, roots))
+        .sum();
+
+    let cx = ctxt::Ctxt::new();
+    let ast = parse::parse(&cx, args, input).expect("parsed once already");
+    let model = model::lower(&cx, ast);
+    let mut raw = Graph::raw();
+    let naive = derive::derive(&cx, &model, &mut raw).expect("derived once already");
+    let _ = cx.check();
+    let naive_all: Vec<ExprId> = functions(&naive).into_iter().flatten().collect();
+    Ok(OpCounts {
+        naive_tree: transform::tree_op_count(&raw, &naive_all),
+        simplified_tree,
+        emitted,
+    })
+}
+
+impl Analysis {
+    /// Every derived quantity as an infix formula, one per line, with the model's names
+    /// (`x'` is the velocity of `x`). This is the symbolic layer of the snapshot tests.
+    pub fn describe(&self) -> String {
+        let m = &self.model;
+        let name = |v: Var| match v {
+            Var::Time => "t".to_owned(),
+            Var::Q(i) => m.coords[i as usize].name.to_string(),
+            Var::Qd(i) => format!("{}'", m.coords[i as usize].name),
+            Var::Delta(i) => format!("δ{}", m.coords[i as usize].name),
+            Var::Param(i) => m.params[i as usize].name.to_string(),
+        };
+        let g = &self.graph;
+        let d = &self.derived;
+        let f = |e: ExprId| display::to_infix(g, e, &name);
+        let mut s = String::new();
+        let coord = |i: u32| m.coords[i as usize].name.to_string();
+        let _ = writeln!(s, "T = {}", f(d.kinetic));
+        let _ = writeln!(s, "V = {}", f(d.potential));
+        for e in &d.mass {
+            let _ = writeln!(s, "M[{}, {}] = {}", coord(e.row), coord(e.col), f(e.expr));
+        }
+        for (i, &q) in d.forces.iter().enumerate() {
+            let _ = writeln!(s, "Q[{}] = {}", m.coords[i].name, f(q));
+        }
+        for (r, item) in m.holonomic.iter().enumerate() {
+            let _ = writeln!(s, "C[{}] = {}", item.name, f(d.c[r]));
+            for e in d.cq.iter().filter(|e| e.row as usize == r) {
+                let _ = writeln!(s, "C_q[{}, {}] = {}", item.name, coord(e.col), f(e.expr));
+            }
+            if !g.is_zero(d.ct[r]) {
+                let _ = writeln!(s, "C_t[{}] = {}", item.name, f(d.ct[r]));
+            }
+            let _ = writeln!(s, "γ_h[{}] = {}", item.name, f(d.gamma_h[r]));
+        }
+        for (r, item) in m.nonholonomic.iter().enumerate() {
+            for e in d.gm.iter().filter(|e| e.row as usize == r) {
+                let _ = writeln!(s, "G[{}, {}] = {}", item.name, coord(e.col), f(e.expr));
+            }
+            let _ = writeln!(s, "g[{}] = {}", item.name, f(d.gb[r]));
+            let _ = writeln!(s, "γ_nh[{}] = {}", item.name, f(d.gamma_nh[r]));
+        }
+        let _ = writeln!(
+            s,
+            "time dependence: mass {}, forces {}, holonomic {}, nonholonomic {}; conservative {}",
+            d.time.mass, d.time.forces, d.time.holonomic, d.time.nonholonomic, d.conservative
+        );
+        s
+    }
+}
