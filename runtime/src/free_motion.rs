@@ -1,23 +1,23 @@
-//! Free motion of constrained systems (math-spec §8, the second seed paper [S2]: Chen,
+//! Free motion of constrained systems (math-spec §8, the second seed paper \[S2\]: Chen,
 //! Wu & Mei 2016, "Free motion of holonomic system with redundant coordinates").
 //!
 //! Input: a [`Mechanism`] with a regular mass matrix $A = M$, a [`Workspace`], states
 //! $(t, q, \dot q)$ and a choice of applied forces ([`AppliedForces`]). Output: the
-//! explicit multiplier formula of [S2] and the free-motion residual, in the sign of
-//! [S2] (§8.5):
-//! $$A\ddot q = h + F^\mathsf{T}\lambda^{[S2]},\qquad W = F A^{-1} F^\mathsf{T},\qquad
-//!   w = c + F A^{-1} h,\qquad \lambda^{[S2]} = -W^{-1} w,$$
+//! explicit multiplier formula of \[S2\] and the free-motion residual, in the sign of
+//! \[S2\] (§8.5):
+//! $$A\ddot q = h + F^\mathsf{T}\lambda^{[\text{S2}]},\qquad W = F A^{-1} F^\mathsf{T},\qquad
+//!   w = c + F A^{-1} h,\qquad \lambda^{[\text{S2}]} = -W^{-1} w,$$
 //! with $F = J = [C_q; G]$, $c = -\gamma$ (for holonomic rows
 //! $c = C_{tt} + 2C_{qt}\dot q + (C_q\dot q)_q\dot q = -\gamma_h$), and
 //! $h = Q + \partial T/\partial q - T_{\dot q q}\dot q - T_{\dot q t}$, which is exactly
 //! the generated [`Mechanism::forces`]. The applied part $Q$ is
 //! [`Mechanism::applied_forces`]; $h^0 = h - Q$ is fixed by $T$ and $V$, so
 //! $w = w^0 + K Q$ with $w^0 = c + F A^{-1} h^0$ and $K = F A^{-1}$ (affine in $Q$).
-//! $\lambda^{[S1]} = -\lambda^{[S2]}$ is what [`Dynamics`](crate::Dynamics) returns.
+//! $\lambda^{[\text{S1}]} = -\lambda^{[\text{S2}]}$ is what [`Dynamics`](crate::Dynamics) returns.
 //!
-//! The motion is **free** (all constraint forces $R = F^\mathsf{T}\lambda^{[S2]}$ vanish)
+//! The motion is **free** (all constraint forces $R = F^\mathsf{T}\lambda^{[\text{S2}]}$ vanish)
 //! exactly where $w = 0$ (S2-18): $g$ conditions, one per constraint. When $W$ is
-//! singular (redundant constraints) $\lambda^{[S2]} = -W^+ w$ is the minimum-norm
+//! singular (redundant constraints) $\lambda^{[\text{S2}]} = -W^+ w$ is the minimum-norm
 //! multiplier, and still $\lambda = 0 \iff w = 0$.
 //!
 //! Principal items:
@@ -57,7 +57,7 @@ pub enum AppliedForces<'a> {
     /// The model's own ([`Mechanism::applied_forces`]): $h$ = [`Mechanism::forces`].
     #[default]
     AsModeled,
-    /// None: $Q = 0$, the forces of [S2]'s examples before the design (V1, V3).
+    /// None: $Q = 0$, the forces of \[S2\]'s examples before the design (V1, V3).
     Without,
     /// These instead of the model's (length $n$).
     Replaced(&'a [f64]),
@@ -91,7 +91,7 @@ impl Default for FreeMotionParams {
 /// Errors of the free-motion analysis.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FreeMotionError {
-    /// [S2] needs $\det A \ne 0$.
+    /// \[S2\] needs $\det A \ne 0$.
     #[error("mass matrix of `{model}` singular at t = {t} (pivot ratio {ratio:e}): the explicit multiplier formula needs a regular mass matrix; use the augmented solve and check that the multipliers vanish")]
     SingularMass {
         /// The model.
@@ -139,7 +139,7 @@ pub enum FreeMotionError {
     Eval(#[from] EvalError),
 }
 
-/// Everything of math-spec §8.5 at one state, in the sign of [S2].
+/// Everything of math-spec §8.5 at one state, in the sign of \[S2\].
 #[derive(Clone, Debug, PartialEq)]
 #[allow(non_snake_case)]
 pub struct FreeMotionPoint {
@@ -159,15 +159,15 @@ pub struct FreeMotionPoint {
     pub base_residual: Vec<f64>,
     /// $w = w^0 + K Q$: the free-motion residual, one per constraint.
     pub residual: Vec<f64>,
-    /// $\lambda^{[S2]} = -W^+ w$.
+    /// $\lambda^{[\text{S2}]} = -W^+ w$.
     pub lambda_s2: Vec<f64>,
-    /// $\ddot q = A^{-1}(h + F^\mathsf{T}\lambda^{[S2]})$.
+    /// $\ddot q = A^{-1}(h + F^\mathsf{T}\lambda^{[\text{S2}]})$.
     pub qdd: Vec<f64>,
-    /// $R = F^\mathsf{T}\lambda^{[S2]}$, the generalized constraint force.
+    /// $R = F^\mathsf{T}\lambda^{[\text{S2}]}$, the generalized constraint force.
     pub reaction: Vec<f64>,
     /// Numerical rank of $W$ (the number of independent constraints).
     pub rank: usize,
-    /// $\lVert W\lambda^{[S2]} + w\rVert_\infty$: zero unless the redundant constraints
+    /// $\lVert W\lambda^{[\text{S2}]} + w\rVert_\infty$: zero unless the redundant constraints
     /// contradict each other.
     pub consistency: f64,
 }
@@ -194,7 +194,7 @@ impl FreeMotionPoint {
         }
     }
 
-    /// The multipliers in the sign of math-spec §1, $\lambda = -\lambda^{[S2]}$.
+    /// The multipliers in the sign of math-spec §1, $\lambda = -\lambda^{[\text{S2}]}$.
     #[must_use]
     pub fn lambda(&self) -> Vec<f64> {
         self.lambda_s2.iter().map(|l| -l).collect()

@@ -158,7 +158,7 @@ pub trait Mechanism {
     /// `applied` in place of the model's own (length `n`): for every constraint, holonomic
     /// rows first, $w = -\gamma + J M^{-1}(Q^0 + Q)$ with
     /// $Q^0 = $ `forces − applied_forces` (so $w = c + F A^{-1} h$ in the notation of
-    /// [S2], $c = -\gamma_h$). Writes `m_h + m_nh` values into `out`.
+    /// \[S2\], $c = -\gamma_h$). Writes `m_h + m_nh` values into `out`.
     ///
     /// The generator emits it, as closed-form expressions, only when the mass matrix is
     /// diagonal or constant; it then returns `true`. The default writes nothing and

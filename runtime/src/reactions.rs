@@ -10,9 +10,9 @@
 //!
 //! **Signs.** math-spec §1: $M\ddot q + C_q^\mathsf{T}\lambda_h + G^\mathsf{T}\lambda_{nh}
 //! = Q$, so constraint $k$ pushes on the system with $-J_k^\mathsf{T}\lambda_k$. The
-//! second seed paper ([S2], Chen, Wu & Mei 2016) writes the multiplier term on the
-//! right-hand side, $\lambda^{[S2]} = -\lambda$, and its constraint force
-//! $R = F^\mathsf{T}\lambda^{[S2]}$ is the same vector as ours
+//! second seed paper (\[S2\], Chen, Wu & Mei 2016) writes the multiplier term on the
+//! right-hand side, $\lambda^{[\text{S2}]} = -\lambda$, and its constraint force
+//! $R = F^\mathsf{T}\lambda^{[\text{S2}]}$ is the same vector as ours
 //! ([`Reactions::lambda_s2`]).
 //!
 //! **Redundant constraints.** When $J$ is rank deficient, [`Dynamics`] returns the
@@ -111,7 +111,7 @@ impl Reactions {
         &self.lambda[self.info.nh()..]
     }
 
-    /// The multipliers in the sign of [S2], $\lambda^{[S2]} = -\lambda$.
+    /// The multipliers in the sign of \[S2\], $\lambda^{[\text{S2}]} = -\lambda$.
     #[must_use]
     pub fn lambda_s2(&self) -> Vec<f64> {
         self.lambda.iter().map(|l| -l).collect()

@@ -2,7 +2,7 @@
 //!
 //! - **Forces.** $w = w^0 + K Q$ is affine in the applied forces, so the forces that make
 //!   the motion free at a state are $Q \in F^\mathsf{T}\lambda^0 + \ker K$ with
-//!   $\lambda^0$ the [S2] multiplier of the system without applied forces (the design
+//!   $\lambda^0$ the \[S2\] multiplier of the system without applied forces (the design
 //!   remark of §8.6). [`ForceDesign`] picks one member: the least 2-norm one, the
 //!   would-be constraint forces $F^\mathsf{T}\lambda^0$ themselves (least
 //!   $A^{-1}$-norm), or the least-squares solution restricted to chosen components,
@@ -24,7 +24,7 @@ use crate::{Mechanism, Workspace};
 pub enum ForceDesign<'a> {
     /// The $Q$ of least 2-norm: $Q = K^\mathsf{T}(K K^\mathsf{T})^+(-w^0)$.
     MinimumNorm,
-    /// "Apply the would-be constraint forces": $Q = F^\mathsf{T}\lambda^{0[S2]}$, the
+    /// "Apply the would-be constraint forces": $Q = F^\mathsf{T}\lambda^{0[\text{S2}]}$, the
     /// solution of least $A^{-1}$-norm.
     ConstraintForces,
     /// Only these components of $Q$ (coordinate indices) may be non-zero: the

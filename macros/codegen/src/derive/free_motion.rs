@@ -1,4 +1,4 @@
-//! Free-motion conditions (math-spec §8.6–§8.9, [S2] eq. 18), derived symbolically.
+//! Free-motion conditions (math-spec §8.6–§8.9, \[S2\] eq. 18), derived symbolically.
 //!
 //! Input: the derived mass matrix $A$, forces $h$ (the generated `forces`, which already
 //! hold $Q + \partial T/\partial q - T_{\dot q q}\dot q - T_{\dot q t}$), the declared
@@ -150,7 +150,7 @@ pub fn derive(g: &mut Graph, inputs: &Inputs<'_>) -> Option<FreeMotion> {
 
 /// The conditions $w_\beta = 0$ as infix text: coordinates by name, velocities primed
 /// (`q1'`), the applied force on coordinate `x` as `Q_x`, parameters by name, e.g.
-/// `2*q1' + t*Q_q1 + 2*Q_q2 - 3*Q_q3` for Example 1 of [S2].
+/// `2*q1' + t*Q_q1 + 2*Q_q2 - 3*Q_q3` for Example 1 of \[S2\].
 pub fn formulas(g: &Graph, model: &Model, fm: &FreeMotion) -> Vec<String> {
     let name = |v: Var| match v {
         Var::Time => "t".to_owned(),
