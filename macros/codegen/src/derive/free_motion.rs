@@ -105,7 +105,7 @@ pub fn derive(g: &mut Graph, inputs: &Inputs<'_>) -> Option<FreeMotion> {
         return None;
     }
     let inv = inverse(g, n, inputs.mass)?;
-    // A⁻¹ is symmetric; column s of row-entry (k, s) is used as K_βs = Σ_k J_βk A⁻¹_ks.
+    // K_βs = Σ_k J_βk (A⁻¹)_ks, over the non-zero entries of row k of A⁻¹.
     let h0: Vec<ExprId> = (0..n)
         .map(|s| g.sub(inputs.forces[s], inputs.applied[s]))
         .collect();
