@@ -14,6 +14,7 @@
 //! | [`sleigh`] | `x y phi` | 1 non-holonomic |
 //! | [`seed2_example1`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
 //! | [`seed2_example2`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
+//! | [`parallelogram`] | `th1 th2 th3 x y phi` | 6 holonomic (one redundant) |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -31,6 +32,8 @@
 mod andrews_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
+#[path = "parallelogram.rs"]
+mod parallelogram_model;
 #[path = "pendulum.rs"]
 mod pendulum_model;
 #[path = "seed2_example1.rs"]
@@ -44,6 +47,7 @@ mod slider_crank_model;
 
 pub use andrews_model::andrews;
 pub use car_axis_model::car_axis;
+pub use parallelogram_model::parallelogram;
 pub use pendulum_model::pendulum;
 pub use seed2_example1_model::seed2_example1;
 pub use seed2_example2_model::seed2_example2;
@@ -96,6 +100,11 @@ static ALL: &[Entry] = &[
         name: "seed2_example2",
         summary: "free motion with redundant coordinates, example 2 (math-spec §8.8, V4)",
         make: || Box::new(seed2_example2::Model::default()),
+    },
+    Entry {
+        name: "parallelogram",
+        summary: "parallelogram linkage with a redundant third crank (reactions of redundant constraints)",
+        make: || Box::new(parallelogram::Model::default()),
     },
 ];
 

@@ -2,6 +2,7 @@
 
 use crate::assembly::AssemblyError;
 use crate::dynamics::DynamicsError;
+use crate::free_motion::FreeMotionError;
 use crate::kinematics::KinematicsError;
 use crate::partition::PartitionError;
 use crate::workspace::EvalError;
@@ -24,4 +25,7 @@ pub enum Error {
     /// Accelerations and multipliers.
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
+    /// Free-motion analysis.
+    #[error(transparent)]
+    FreeMotion(#[from] FreeMotionError),
 }

@@ -15,6 +15,10 @@
 //!   and [assembly](Kinematics::assemble) of consistent initial conditions.
 //! - [`Dynamics`]: accelerations and multipliers from the augmented system, dense or
 //!   sparse, with minimum-norm multipliers for redundant constraints.
+//! - [`ReactionAnalysis`]: multipliers and generalized constraint forces per named
+//!   constraint ([`Reactions`]), at a state or along a trajectory.
+//! - [`FreeMotion`]: the explicit multiplier formula and free-motion analysis of the
+//!   second seed paper, with the inverse problems ([`free_motion`]).
 //! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
 //!   [`ode::OdeSystem`], with dense output, restarts and statistics.
 //! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
@@ -29,12 +33,14 @@ mod assembly;
 mod dynamics;
 mod error;
 mod ext;
+pub mod free_motion;
 mod kinematics;
 mod linalg;
 mod linearize;
 mod mechanism;
 pub mod ode;
 mod partition;
+mod reactions;
 pub mod sim;
 mod workspace;
 
@@ -45,12 +51,18 @@ pub use dynamics::{
 };
 pub use error::Error;
 pub use ext::{DerivativeCheck, MechanismExt, Residuals};
+pub use free_motion::{
+    AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
+};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
 };
 pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
+pub use reactions::{
+    ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,
+};
 pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Workspace};
 
 /// Items used by generated code. Not part of the public API.

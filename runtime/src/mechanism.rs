@@ -141,6 +141,49 @@ pub trait Mechanism {
     /// velocity vector `Q_v = ∂T/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t`.
     fn forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
 
+    /// The applied generalized forces `Q_e` declared by the model (`#[force]` items and
+    /// the coefficients of a virtual work), length `n`. They are part of
+    /// [`forces`](Self::forces); what remains, `forces − applied_forces`, is the part
+    /// fixed by the kinetic and potential energy.
+    ///
+    /// The free-motion analysis ([`FreeMotion`](crate::FreeMotion)) uses the split to
+    /// evaluate or replace the applied forces. The default writes zeros: a model that
+    /// does not separate them has all of `forces` in the fixed part.
+    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let _ = (t, q, qd);
+        out.fill(0.0);
+    }
+
+    /// The free-motion residual of math-spec §8.6 (S2-18) with the applied forces
+    /// `applied` in place of the model's own (length `n`): for every constraint, holonomic
+    /// rows first, $w = -\gamma + J M^{-1}(Q^0 + Q)$ with
+    /// $Q^0 = $ `forces − applied_forces` (so $w = c + F A^{-1} h$ in the notation of
+    /// \[S2\], $c = -\gamma_h$). Writes `m_h + m_nh` values into `out`.
+    ///
+    /// The generator emits it, as closed-form expressions, only when the mass matrix is
+    /// diagonal or constant; it then returns `true`. The default writes nothing and
+    /// returns `false`; [`FreeMotion`](crate::FreeMotion) computes the same residual
+    /// numerically for any regular mass matrix.
+    fn free_motion_residual(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        applied: &[f64],
+        out: &mut [f64],
+    ) -> bool {
+        let _ = (t, q, qd, applied, out);
+        false
+    }
+
+    /// The free-motion conditions `w = 0` as printable infix formulas, one per
+    /// constraint (holonomic first), in terms of `t`, the coordinates, their velocities
+    /// `x'` and the applied forces `Q_x`; empty unless
+    /// [`free_motion_residual`](Self::free_motion_residual) is generated.
+    fn free_motion_conditions(&self) -> &'static [&'static str] {
+        &[]
+    }
+
     /// The holonomic constraints `C(q, t)` (length `m_h`).
     fn holonomic(&self, t: f64, q: &[f64], out: &mut [f64]) {
         let _ = (t, q);

@@ -9,8 +9,14 @@ mod accuracy;
 #[cfg(test)]
 mod cli;
 #[cfg(test)]
+mod free_motion;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;
 #[cfg(test)]
 mod ui;
+
+/// The chapter `docs/free-motion.md`; its code blocks run as doctests.
+#[doc = include_str!("../../docs/free-motion.md")]
+pub mod free_motion_chapter {}

@@ -17,6 +17,7 @@
 //! reported here with the span of the offending item.
 
 mod checks;
+pub mod free_motion;
 
 use crate::ctxt::Ctxt;
 use crate::model::expr::{Context, Translator};
@@ -51,6 +52,8 @@ pub struct Derived {
     pub initial: Option<(Vec<ExprId>, Vec<ExprId>)>,
     pub mass: Vec<Entry>,
     pub forces: Vec<ExprId>,
+    /// The declared applied forces (`#[force]` items and virtual work), part of `forces`.
+    pub applied: Vec<ExprId>,
     pub kinetic: ExprId,
     pub potential: ExprId,
     pub c: Vec<ExprId>,
@@ -63,6 +66,8 @@ pub struct Derived {
     pub time: TimeDeps,
     pub homogeneous: bool,
     pub conservative: bool,
+    /// The free-motion residuals, when the mass matrix has a printable inverse.
+    pub free_motion: Option<free_motion::FreeMotion>,
 }
 
 fn idx(i: usize) -> u32 {
@@ -171,6 +176,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         }
     }
     let mut forces = Vec::with_capacity(n);
+    let mut applied_forces = Vec::with_capacity(n);
     for i in 0..n {
         let qi = Var::Q(idx(i));
         let dt_dq = diff::differentiate(g, t_kin, qi);
@@ -182,6 +188,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         let neg_dpdt = g.neg(dp_dt);
         let neg_dv = g.neg(dv_dq);
         forces.push(g.add(vec![qe, dt_dq, neg_conv, neg_dpdt, neg_dv]));
+        applied_forces.push(qe);
     }
     let mut has_virtual_work = false;
     for (k, w) in virtual_work {
@@ -190,6 +197,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         let coefficients = checks::virtual_work(cx, model, g, k, w, checking)?;
         for (i, c) in coefficients.into_iter().enumerate() {
             forces[i] = g.add(vec![forces[i], c]);
+            applied_forces[i] = g.add(vec![applied_forces[i], c]);
         }
     }
 
@@ -300,11 +308,27 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         && !time.holonomic
         && !time.nonholonomic;
 
+    let rows = (0..c.len())
+        .map(|r| (row_of(&cq, r), gamma_h[r]))
+        .chain((0..gb.len()).map(|r| (row_of(&gm, r), gamma_nh[r])))
+        .collect();
+    let free_motion = free_motion::derive(
+        g,
+        &free_motion::Inputs {
+            n,
+            mass: &mass,
+            forces: &forces,
+            applied: &applied_forces,
+            rows,
+        },
+    );
+
     Some(Derived {
         param_defaults,
         initial,
         mass,
         forces,
+        applied: applied_forces,
         kinetic: t_kin,
         potential: v_pot,
         c,
@@ -317,5 +341,15 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         time,
         homogeneous,
         conservative,
+        free_motion,
     })
+}
+
+/// The entries of row `r` of a pattern-ordered matrix.
+fn row_of(entries: &[Entry], r: usize) -> Vec<Entry> {
+    entries
+        .iter()
+        .filter(|e| e.row == idx(r))
+        .copied()
+        .collect()
 }

@@ -262,6 +262,10 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         false,
     ));
     fns.extend(vector_fn(g, &names, "forces", &d.forces, true));
+    if any_nonzero(g, &d.applied) {
+        fns.extend(vector_fn(g, &names, "applied_forces", &d.applied, true));
+    }
+    let free_motion = free_motion(g, &names, model, d, &mut fns);
     if !d.c.is_empty() {
         fns.extend(vector_fn(g, &names, "holonomic", &d.c, false));
         fns.extend(vector_fn(
@@ -398,6 +402,8 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 conservative: #conservative,
             };
 
+            #free_motion
+
             #[allow(non_snake_case, clippy::all, clippy::pedantic)]
             impl ::pfaff::__private::Mechanism for Model {
                 fn info(&self) -> &'static ::pfaff::__private::Info {
@@ -412,6 +418,67 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 #fns
             }
         }
+    }
+}
+
+/// The free-motion residual `w = w0 + K Q` (math-spec §8.6) as the trait methods
+/// `free_motion_residual` and `free_motion_conditions` (added to `fns`), and the module
+/// item `FREE_MOTION` with the printed conditions (returned). Nothing when the model has
+/// no free-motion derivation.
+fn free_motion(
+    g: &Graph,
+    names: &ModelNames,
+    model: &Model,
+    d: &Derived,
+    fns: &mut TokenStream,
+) -> TokenStream {
+    let Some(fm) = &d.free_motion else {
+        return TokenStream::new();
+    };
+    let m = fm.base.len();
+    let mut roots = fm.base.clone();
+    roots.extend(fm.coefficients.iter().map(|e| e.expr));
+    let (code, prog) = body(g, names, &roots, |k, ts| {
+        if k < m {
+            let k = Literal::usize_unsuffixed(k);
+            quote!(out[#k] = #ts;)
+        } else {
+            let e = fm.coefficients[k - m];
+            let (r, c) = (
+                Literal::u32_unsuffixed(e.row),
+                Literal::u32_unsuffixed(e.col),
+            );
+            quote!(out[#r] += #ts * applied[#c];)
+        }
+    });
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
+    let applied = if fm.coefficients.is_empty() {
+        format_ident!("_applied")
+    } else {
+        format_ident!("applied")
+    };
+    fns.extend(quote! {
+        fn free_motion_residual(
+            &self, #t: f64, #q: &[f64], #qd: &[f64], #applied: &[f64], out: &mut [f64],
+        ) -> bool {
+            #code
+            true
+        }
+        fn free_motion_conditions(&self) -> &'static [&'static str] {
+            FREE_MOTION
+        }
+    });
+    let formulas = crate::derive::free_motion::formulas(g, model, fm);
+    let doc = doc_attr(
+        "The free-motion conditions `w = 0` of math-spec §8.6, one per constraint \
+         (holonomic first),\nwith `x'` the velocity of `x` and `Q_x` the applied force \
+         on `x`; the motion is free\n(all multipliers zero) exactly where they hold.",
+    );
+    quote! {
+        #doc
+        pub const FREE_MOTION: &[&str] = &[#(#formulas),*];
     }
 }
 
