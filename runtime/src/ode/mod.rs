@@ -16,7 +16,8 @@
 //! All implement [`Integrator`]: [`reset`](Integrator::reset) (also a hard restart),
 //! [`step`](Integrator::step) (one accepted step, never past `t_stop`),
 //! [`interpolate`](Integrator::interpolate), [`set_state`](Integrator::set_state) and
-//! [`stats`](Integrator::stats).
+//! [`stats`](Integrator::stats). [`EventLocator`] finds zero crossings of an event
+//! function on the dense output, for impacts and other discontinuities.
 
 mod adams;
 mod common;
@@ -24,6 +25,7 @@ mod dop853;
 mod dop853_tableau;
 mod dopri5;
 mod error;
+mod events;
 mod integrator;
 mod options;
 mod rk4;
@@ -34,6 +36,7 @@ pub use adams::Adams;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use error::{OdeError, Quantity};
+pub use events::{Crossing, EventLocator};
 pub use integrator::Integrator;
 pub use options::{OdeOptions, OdeStats, Tolerances};
 pub use rk4::Rk4;
