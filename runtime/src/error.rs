@@ -4,6 +4,7 @@ use crate::assembly::AssemblyError;
 use crate::dynamics::DynamicsError;
 use crate::free_motion::FreeMotionError;
 use crate::kinematics::KinematicsError;
+use crate::linearize::LinearizeError;
 use crate::partition::PartitionError;
 use crate::workspace::EvalError;
 
@@ -28,4 +29,7 @@ pub enum Error {
     /// Free-motion analysis.
     #[error(transparent)]
     FreeMotion(#[from] FreeMotionError),
+    /// Linearization.
+    #[error(transparent)]
+    Linearize(#[from] LinearizeError),
 }
