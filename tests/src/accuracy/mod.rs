@@ -16,7 +16,7 @@ mod util;
 
 mod andrews;
 mod car_axis;
-mod coverage;
+pub(crate) mod coverage;
 mod pendulum;
 mod seed2;
 mod sleigh;
