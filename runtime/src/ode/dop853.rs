@@ -18,8 +18,8 @@
 //! $\text{fac}_1 = 0.333$, $\text{fac}_2 = 6$, exponent $1/8$.
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, hinit, limit_to_stop, PiController,
-    UROUND,
+    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop, PiController,
+    underflows, RECOVER_FACTOR,
 };
 use super::dop853_tableau::{A, BHH, C, D, ER};
 use super::error::OdeError;
@@ -156,6 +156,19 @@ impl Dop853 {
         Ok(h.abs() * e5 * (1.0 / (self.y.len() as f64 * deno)).sqrt())
     }
 
+    /// After a failed attempt of size `h`: a recoverable failure of the right-hand side
+    /// counts as a rejection and cuts the step by [`RECOVER_FACTOR`]; any other error,
+    /// or a step that would underflow, is returned.
+    fn recover(&mut self, e: OdeError, h: f64) -> Result<(), OdeError> {
+        let h_new = h * RECOVER_FACTOR;
+        if !is_recoverable(&e) || underflows(self.t, h_new) {
+            return Err(e);
+        }
+        self.stats.rejected += 1;
+        self.h = h_new;
+        Ok(())
+    }
+
     /// Evaluates the three extra stages and stores the interpolant of the accepted step
     /// (before `y` is replaced; `k[FSAL]` must hold $f(t+h, y_{n+1})$).
     fn store_dense<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<(), OdeError> {
@@ -261,11 +274,18 @@ impl Integrator for Dop853 {
             }
             let h = self.dir * self.h.abs().min(self.opts.h_max);
             let (h, hits) = limit_to_stop(self.t, h, t_stop);
-            if !hits && 0.1 * h.abs() <= self.t.abs() * UROUND {
+            if !hits && underflows(self.t, h) {
                 return Err(OdeError::StepSizeTooSmall { t: self.t, h });
             }
             self.attempts += 1;
-            let err = self.attempt(sys, h)?;
+            let err = match self.attempt(sys, h) {
+                Ok(err) => err,
+                Err(e) => {
+                    self.recover(e, h)?;
+                    rejected = true;
+                    continue;
+                }
+            };
             let (h_new, accepted) = self.ctrl.control(err, h);
             if !accepted {
                 rejected = true;
@@ -281,11 +301,18 @@ impl Integrator for Dop853 {
                 (true, Some(ts)) => ts,
                 _ => self.t + h,
             };
-            eval(sys, &mut self.stats, t_new, &self.y_new, &mut self.k[FSAL])?;
+            let mut fsal = eval(sys, &mut self.stats, t_new, &self.y_new, &mut self.k[FSAL]);
             self.dense_ready = false;
-            if self.opts.dense_output {
-                self.store_dense(sys, h)?;
-                self.dense_ready = true;
+            if fsal.is_ok() && self.opts.dense_output {
+                fsal = self.store_dense(sys, h);
+                self.dense_ready = fsal.is_ok();
+            }
+            if let Err(e) = fsal {
+                // The new state or a dense-output stage failed recoverably: the
+                // attempt is rejected like one with a large error.
+                self.recover(e, h)?;
+                rejected = true;
+                continue;
             }
             std::mem::swap(&mut self.y, &mut self.y_new);
             self.k.swap(0, FSAL);

@@ -183,6 +183,7 @@ fn recoverable(e: &OdeError) -> bool {
             source.downcast_ref::<Error>(),
             Some(Error::Kinematics(
                 KinematicsError::NewtonFailed { .. }
+                    | KinematicsError::BranchSwitch { .. }
                     | KinematicsError::SingularDependent { .. }
                     | KinematicsError::SingularVelocity { .. }
             ))
@@ -261,6 +262,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         // Assembly left its partition current: Algorithm P with the prescribed
         // coordinates kept independent (exactly Algorithm P without a prescription).
         sys.update_indices();
+        if let Err(e) = sys.accept(t0) {
+            return Err(empty(SimErrorKind::from_analysis(e, Vec::new())));
+        }
     }
 
     let rows = match sim.output {
@@ -374,7 +378,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                         .kin
                         .monitor(mech, &mut sys.ws, t, &sys.q)
                         .map_err(|e| analysis(e.into())));
+                    check!(rec.sys.accept(t).map_err(analysis));
                     if moved && t < t_end && rec.sys.update_indices() {
+                        check!(rec.sys.accept(t).map_err(analysis));
                         rec.sys.gather(rec.y);
                         check!(stepper.reset(&mut rec.sys, t, rec.y, None).map_err(ode));
                     }
@@ -406,6 +412,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                     bail!(SimErrorKind::from_ode(e, constraints));
                 }
                 rec.sys.update_indices();
+                check!(rec.sys.accept(ta).map_err(analysis));
                 rec.sys.gather(rec.y);
                 let h = stepper.h_next().abs() / 8.0;
                 let h0 = (!stepper.is_fixed_step() && h.is_finite() && h > 0.0).then_some(h);

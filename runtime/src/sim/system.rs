@@ -25,6 +25,16 @@ use crate::{Error, Info, Mechanism};
 /// Pivot ratio below which the projection matrix counts as singular.
 const SINGULAR_RATIO: f64 = 1e-14;
 
+/// Recoverable kinematic failures in a row (since the last accepted step) before a
+/// failure stops the integrator: with the integrators' cut of 4 per failure the step
+/// has then shrunk by $4^{10} \approx 10^6$, and the driver's re-partition is the
+/// better cure.
+const MAX_RETRIES: u32 = 10;
+
+/// Relative size of a Newton correction of the K1 guess that never counts as a branch
+/// switch (see [`MechSystem::rhs`]), for the evaluations that hardly move.
+const BRANCH_FLOOR: f64 = 1e-8;
+
 pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub mech: &'a M,
     pub info: &'static Info,
@@ -52,6 +62,19 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub factorizations: u64,
     /// Holonomic constraints not met when the last analysis failed.
     pub failure_constraints: Vec<&'static str>,
+    /// Partitioning: the last accepted full state, its time and the sign of
+    /// $\det J_d$ there (the reference of the branch check).
+    q_acc: Vec<f64>,
+    qd_acc: Vec<f64>,
+    t_acc: f64,
+    sign_acc: f64,
+    /// Recoverable failures since the last accepted step.
+    retries: u32,
+    /// Partitioning, the last K1: its guess, the largest move of a coordinate from the
+    /// base state to the guess, and the largest Newton correction of the guess.
+    guess: Vec<f64>,
+    moved: f64,
+    correction: f64,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for MechSystem<'_, M> {
@@ -100,6 +123,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             failure_constraints: Vec::new(),
+            q_acc: vec![0.0; n],
+            qd_acc: vec![0.0; n],
+            t_acc: 0.0,
+            sign_acc: 0.0,
+            retries: 0,
+            guess: vec![0.0; n],
+            moved: 0.0,
+            correction: 0.0,
         })
     }
 
@@ -123,6 +154,26 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         self.gamma.clear();
         self.gamma.extend_from_slice(p.independent());
         true
+    }
+
+    /// Partitioning: takes the current full state (consistent, at `t`) as the last
+    /// accepted one: the reference of the branch check and the state an evaluation
+    /// that failed recoverably falls back to. Runs K2 for the sign of $\det J_d$ under
+    /// the current partition (so call it again after a re-partition).
+    pub fn accept(&mut self, t: f64) -> Result<(), Error> {
+        if self.form != Formulation::Partitioning {
+            return Ok(());
+        }
+        self.factorizations += 1;
+        self.kin
+            .velocity(self.mech, &mut self.ws, t, &self.q, &mut self.qd)?;
+        self.q_acc.copy_from_slice(&self.q);
+        self.qd_acc.copy_from_slice(&self.qd);
+        self.t_acc = t;
+        self.t_state = t;
+        self.sign_acc = self.kin.dependent_sign();
+        self.retries = 0;
+        Ok(())
     }
 
     /// Writes the state vector of the current full state `q`, `qd` into `y`.
@@ -151,7 +202,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         match self.form {
             Formulation::Partitioning => {
                 let np = self.coords.len();
+                let mut moved = 0.0_f64;
                 for (k, &j) in self.coords.iter().enumerate() {
+                    moved = moved.max((y[k] - self.q[j]).abs());
                     self.q[j] = y[k];
                 }
                 // First-order predictor for the guess of β: the last evaluation's β
@@ -161,9 +214,17 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 if let Some(p) = self.kin.partition() {
                     for &j in p.dependent() {
                         self.q[j] += self.qd[j] * dt;
+                        moved = moved.max((self.qd[j] * dt).abs());
                     }
                 }
+                self.guess.copy_from_slice(&self.q);
                 let r = self.kin.position(self.mech, &mut self.ws, t, &mut self.q);
+                self.correction = self.kin.partition().map_or(0.0, |p| {
+                    p.dependent()
+                        .iter()
+                        .fold(0.0_f64, |a, &j| a.max((self.q[j] - self.guess[j]).abs()))
+                });
+                self.moved = moved;
                 let iterations = self.kin.residual_history().len().saturating_sub(1) as u64;
                 self.newton_iterations += iterations;
                 self.factorizations += iterations;
@@ -357,6 +418,11 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
 
     fn rhs_inner(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.reconstruct(t, y)?;
+        self.rhs_inner_full(t, dy)
+    }
+
+    /// $\dot y$ from the full state already reconstructed at `t`.
+    fn rhs_inner_full(&mut self, t: f64, dy: &mut [f64]) -> Result<(), Error> {
         self.accelerations(t)?;
         match self.form {
             Formulation::Partitioning => {
@@ -402,7 +468,63 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
         self.dim
     }
 
+    /// Partitioning: a kinematic failure of K1 or K2 (Newton diverged, a singular
+    /// dependent block, or a jump to another solution branch) comes from a guess
+    /// extrapolated too far, so it is [recoverable](RhsError::recoverable).
+    ///
+    /// K1 has jumped branches when
+    /// - the sign of $\det J_d$ differs from the last accepted state's (the mirror
+    ///   assembly, see [`Kinematics::dependent_sign`]), or
+    /// - Newton corrected the guess by more than the largest move of a coordinate
+    ///   from the base state to the guess (plus [`BRANCH_FLOOR`]): along the motion
+    ///   the first-order predictor moves by $O(h)$ and errs by $O(h^2)$, so a larger
+    ///   correction means the step is outside the predictor's range, as when an angle
+    ///   lands on another turn ($\beta + 2\pi k$: same sign, same configuration, a
+    ///   discontinuous state).
+    ///
+    /// The integrator then retries a shorter step
+    /// from the last accepted state, which also becomes the base of the next guess.
+    /// After [`MAX_RETRIES`] such failures in a row the failure stops the integrator
+    /// and the driver re-partitions.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        self.rhs_inner(t, y, dy).map_err(RhsError::new)
+        if self.form != Formulation::Partitioning {
+            return self.rhs_inner(t, y, dy).map_err(RhsError::new);
+        }
+        let r = self.reconstruct(t, y).and_then(|()| {
+            let sign = self.kin.dependent_sign();
+            let floor = BRANCH_FLOOR * (1.0 + inf_norm(&self.q));
+            if (self.sign_acc != 0.0 && sign != self.sign_acc)
+                || self.correction > self.moved + floor
+            {
+                let history = self.kin.residual_history();
+                return Err(Error::Kinematics(KinematicsError::BranchSwitch {
+                    t,
+                    iterations: history.len().saturating_sub(1),
+                    residual: history.last().copied().unwrap_or(0.0),
+                }));
+            }
+            Ok(())
+        });
+        let r = r.and_then(|()| self.rhs_inner_full(t, dy));
+        match r {
+            Ok(()) => Ok(()),
+            Err(e @ Error::Kinematics(
+                KinematicsError::NewtonFailed { .. }
+                | KinematicsError::BranchSwitch { .. }
+                | KinematicsError::SingularDependent { .. }
+                | KinematicsError::SingularVelocity { .. },
+            )) => {
+                self.q.copy_from_slice(&self.q_acc);
+                self.qd.copy_from_slice(&self.qd_acc);
+                self.t_state = self.t_acc;
+                self.retries += 1;
+                if self.retries <= MAX_RETRIES {
+                    Err(RhsError::recoverable(e))
+                } else {
+                    Err(RhsError::new(e))
+                }
+            }
+            Err(e) => Err(RhsError::new(e)),
+        }
     }
 }

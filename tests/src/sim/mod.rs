@@ -5,6 +5,7 @@
 //! benchmark-models.md (the pendulum's exact solution), or a closed form derived in the
 //! test.
 
+mod andrews;
 mod exact;
 mod faults;
 mod models;
