@@ -70,6 +70,8 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     sign_acc: f64,
     /// Recoverable failures since the last accepted step.
     retries: u32,
+    /// Whether `q_acc`, `qd_acc` hold an accepted state.
+    anchored: bool,
     /// Partitioning, the last K1: its guess, the largest move of a coordinate from the
     /// base state to the guess, and the largest Newton correction of the guess.
     guess: Vec<f64>,
@@ -128,6 +130,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             t_acc: 0.0,
             sign_acc: 0.0,
             retries: 0,
+            anchored: false,
             guess: vec![0.0; n],
             moved: 0.0,
             correction: 0.0,
@@ -173,6 +176,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         self.t_state = t;
         self.sign_acc = self.kin.dependent_sign();
         self.retries = 0;
+        self.anchored = true;
         Ok(())
     }
 
@@ -202,14 +206,24 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         match self.form {
             Formulation::Partitioning => {
                 let np = self.coords.len();
+                // The base of the guess is the last accepted state (once there is one):
+                // a state of the motion, so that the predictor errs by O(dt²) and the
+                // branch check of `rhs` can compare the correction with the move.
+                // Chaining from the last evaluation (a stage of a trial step, maybe a
+                // rejected one) gives errors of the order of the move itself.
+                if self.anchored {
+                    self.q.copy_from_slice(&self.q_acc);
+                    self.qd.copy_from_slice(&self.qd_acc);
+                    self.t_state = self.t_acc;
+                }
                 let mut moved = 0.0_f64;
                 for (k, &j) in self.coords.iter().enumerate() {
                     moved = moved.max((y[k] - self.q[j]).abs());
                     self.q[j] = y[k];
                 }
-                // First-order predictor for the guess of β: the last evaluation's β
-                // moved along its velocity. Without it, fast mechanisms (Andrews) and
-                // long steps let Newton converge to another assembly branch.
+                // First-order predictor for the guess of β: the base's β moved along
+                // its velocity. Without it, fast mechanisms (Andrews) and long steps
+                // let Newton converge to another assembly branch.
                 let dt = t - self.t_state;
                 if let Some(p) = self.kin.partition() {
                     for &j in p.dependent() {
