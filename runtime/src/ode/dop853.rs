@@ -18,8 +18,8 @@
 //! $\text{fac}_1 = 0.333$, $\text{fac}_2 = 6$, exponent $1/8$.
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop, PiController,
-    underflows, RECOVER_FACTOR,
+    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop,
+    underflows, PiController, RECOVER_FACTOR,
 };
 use super::dop853_tableau::{A, BHH, C, D, ER};
 use super::error::OdeError;

@@ -17,8 +17,8 @@
 //! [`Tolerances`]: super::Tolerances
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop, rms_norm,
-    PiController, underflows, RECOVER_FACTOR,
+    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop,
+    rms_norm, underflows, PiController, RECOVER_FACTOR,
 };
 use super::error::OdeError;
 use super::integrator::Integrator;

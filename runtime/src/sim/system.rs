@@ -522,12 +522,14 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
         let r = r.and_then(|()| self.rhs_inner_full(t, dy));
         match r {
             Ok(()) => Ok(()),
-            Err(e @ Error::Kinematics(
-                KinematicsError::NewtonFailed { .. }
-                | KinematicsError::BranchSwitch { .. }
-                | KinematicsError::SingularDependent { .. }
-                | KinematicsError::SingularVelocity { .. },
-            )) => {
+            Err(
+                e @ Error::Kinematics(
+                    KinematicsError::NewtonFailed { .. }
+                    | KinematicsError::BranchSwitch { .. }
+                    | KinematicsError::SingularDependent { .. }
+                    | KinematicsError::SingularVelocity { .. },
+                ),
+            ) => {
                 self.q.copy_from_slice(&self.q_acc);
                 self.qd.copy_from_slice(&self.qd_acc);
                 self.t_state = self.t_acc;
