@@ -294,18 +294,21 @@ impl Kinematics {
         let info = ws.info();
         check_state(info, t, q, None)?;
         self.ensure_partition(mech, ws, t, q)?;
-        let (n, mh) = (info.nq(), info.nh());
+        let n = info.nq();
         let Self {
             params,
             lu_h,
             partition,
             history,
+            rhs,
             ..
         } = self;
-        let beta = &partition
-            .as_ref()
-            .expect("partition ensured above")
-            .dependent;
+        let p = partition.as_ref().expect("partition ensured above");
+        let (beta, rows) = (&p.dependent, &p.rows);
+        if lu_h.dim() != rows.len() {
+            // Redundant rows dropped: a smaller block (allocates at a re-partition only).
+            *lu_h = DenseLu::new(rows.len(), 1);
+        }
         let tol = params.newton.tolerance;
         history.clear();
         ws.eval_constraints(mech, t, q)?;
@@ -324,9 +327,9 @@ impl Kinematics {
             ws.eval_jacobian(mech, t, q)?;
             {
                 let mut a = lu_h.matrix_mut();
-                for i in 0..mh {
+                for (r, &i) in rows.iter().enumerate() {
                     for (k, &j) in beta.iter().enumerate() {
-                        a[(i, k)] = ws.jacobian[i * n + j];
+                        a[(r, k)] = ws.jacobian[i * n + j];
                     }
                 }
             }
@@ -338,9 +341,9 @@ impl Kinematics {
                     ratio,
                 });
             }
-            let dx = &mut ws.c;
-            for v in dx.iter_mut() {
-                *v = -*v;
+            let dx = &mut rhs[..rows.len()];
+            for (v, &i) in dx.iter_mut().zip(rows) {
+                *v = -ws.c[i];
             }
             lu_h.solve_vec(dx);
             step = 0.0;
@@ -408,15 +411,22 @@ impl Kinematics {
         } = self;
         let p = partition.as_ref().expect("partition ensured above");
         let dep = || p.dependent.iter().chain(&p.eta);
+        // The rows of J_d: the holonomic rows of β (all unless redundant ones were
+        // dropped), then the non-holonomic ones.
+        let rows = || p.rows.iter().copied().chain(mh..m);
+        let md = p.rows.len() + (m - mh);
+        if lu_d.dim() != md {
+            *lu_d = DenseLu::new(md, 1);
+        }
         {
             let mut a = lu_d.matrix_mut();
-            for i in 0..m {
+            for (r, i) in rows().enumerate() {
                 for (k, &j) in dep().enumerate() {
-                    a[(i, k)] = ws.jacobian[i * n + j];
+                    a[(r, k)] = ws.jacobian[i * n + j];
                 }
             }
         }
-        for (i, r) in rhs.iter_mut().enumerate() {
+        for (r, i) in rhs[..md].iter_mut().zip(rows()) {
             let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
             let row = &ws.jacobian[i * n..(i + 1) * n];
             *r = -c - p.independent.iter().map(|&j| row[j] * qd[j]).sum::<f64>();
@@ -426,7 +436,7 @@ impl Kinematics {
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(KinematicsError::SingularVelocity { t, ratio });
         }
-        lu_d.solve_vec(rhs);
+        lu_d.solve_vec(&mut rhs[..md]);
         for (k, j) in dep().enumerate() {
             qd[*j] = rhs[k];
         }

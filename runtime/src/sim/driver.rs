@@ -158,6 +158,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             trajectory: self.traj.clone(),
             stats,
             monitors: self.monitors,
+            redundant_constraints: self.sys.redundant.clone(),
         }
     }
 
@@ -212,6 +213,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 ..Stats::default()
             },
             monitors: Monitors::default(),
+            redundant_constraints: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -258,6 +260,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
     sys.t_state = t0;
+    sys.redundant = sys.fit_rows();
     if form == Formulation::Partitioning {
         // Assembly left its partition current: Algorithm P with the prescribed
         // coordinates kept independent (exactly Algorithm P without a prescription).

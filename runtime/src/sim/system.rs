@@ -62,6 +62,12 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub factorizations: u64,
     /// Holonomic constraints not met when the last analysis failed.
     pub failure_constraints: Vec<&'static str>,
+    /// Constraints the augmented solve found redundant so far.
+    pub redundant: Vec<&'static str>,
+    /// Projection: the constraint rows projected on, the first `rows_h` holonomic
+    /// (all rows unless Algorithm P dropped redundant ones, see [`Self::fit_rows`]).
+    rows: Vec<usize>,
+    rows_h: usize,
     /// Partitioning: the last accepted full state, its time and the sign of
     /// $\det J_d$ there (the reference of the branch check).
     q_acc: Vec<f64>,
@@ -125,6 +131,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             failure_constraints: Vec::new(),
+            redundant: Vec::new(),
+            rows: (0..m).collect(),
+            rows_h: mh,
             q_acc: vec![0.0; n],
             qd_acc: vec![0.0; n],
             t_acc: 0.0,
@@ -135,6 +144,38 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             moved: 0.0,
             correction: 0.0,
         })
+    }
+
+    /// Fits the state dimension (partitioning) or the projected rows (projection) to
+    /// the partition of the assembly, which may have dropped redundant holonomic
+    /// constraints; returns the names of the dropped ones.
+    pub fn fit_rows(&mut self) -> Vec<&'static str> {
+        let Some(p) = self.kin.partition() else {
+            return Vec::new();
+        };
+        let info = self.info;
+        let (n, mh, nnh) = (info.nq(), info.nh(), info.nnh());
+        let names = p
+            .redundant_rows()
+            .iter()
+            .map(|&i| info.holonomic[i].name)
+            .collect();
+        let r = p.holonomic_rows().len();
+        match self.form {
+            Formulation::Partitioning => self.dim = (2 * (n - r) - nnh).max(1),
+            Formulation::Projection => {
+                self.rows.clear();
+                self.rows.extend_from_slice(p.holonomic_rows());
+                self.rows.extend(mh..mh + nnh);
+                self.rows_h = r;
+                if r != mh {
+                    self.lu_h = DenseLu::new(r, 1);
+                    self.lu_v = DenseLu::new(r + nnh, 1);
+                }
+            }
+            Formulation::Baumgarte { .. } => {}
+        }
+        names
     }
 
     /// Copies the index sets of the current partition (no allocation: the capacity is
@@ -311,6 +352,11 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             &mut self.qdd,
             &mut self.lambda,
         )?;
+        // Reported once, as first identified: which rows of a dependent set the
+        // pivoting names can change along the motion, the redundancy does not.
+        if self.redundant.is_empty() {
+            self.redundant.extend(self.dynamics.redundant_constraints());
+        }
         Ok(())
     }
 
@@ -373,7 +419,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     });
                 }
                 self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
-                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, mh, n);
+                let rows = &self.rows[..self.rows_h];
+                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
@@ -382,12 +429,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                         constraints: self.violated(bound),
                     });
                 }
-                self.mu[..mh].copy_from_slice(self.ws.constraints());
-                self.lu_h.solve_vec(&mut self.mu[..mh]);
-                for i in 0..mh {
+                for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                    *mu = self.ws.constraints()[i];
+                }
+                self.lu_h.solve_vec(&mut self.mu[..rows.len()]);
+                for (&i, mu) in rows.iter().zip(&self.mu) {
                     let row = &self.ws.jacobian[i * n..(i + 1) * n];
                     for (qj, a) in self.q.iter_mut().zip(row) {
-                        *qj -= a * self.mu[i];
+                        *qj -= a * mu;
                     }
                 }
                 iterations += 1;
@@ -398,7 +447,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         if m > 0 {
             self.velocity_terms(t).map_err(eval)?;
             self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
-            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, m, n);
+            let rows = &self.rows[..];
+            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, rows, n);
             self.factorizations += 1;
             if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                 return Err(SimErrorKind::Singular {
@@ -408,12 +458,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     constraints: Vec::new(),
                 });
             }
-            self.mu.copy_from_slice(&self.vel);
-            self.lu_v.solve_vec(&mut self.mu);
-            for i in 0..m {
+            for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                *mu = self.vel[i];
+            }
+            self.lu_v.solve_vec(&mut self.mu[..rows.len()]);
+            for (&i, mu) in rows.iter().zip(&self.mu) {
                 let row = &self.ws.jacobian[i * n..(i + 1) * n];
                 for (v, a) in self.qd.iter_mut().zip(row) {
-                    *v -= a * self.mu[i];
+                    *v -= a * mu;
                 }
             }
         }
@@ -459,15 +511,15 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
     }
 }
 
-/// Writes $A A^\mathsf{T}$ of the first `rows` rows of the dense row-major `a`
-/// (`rows × n`) into `lu`, factors it and returns the pivot ratio.
-fn gram(lu: &mut DenseLu, a: &[f64], rows: usize, n: usize) -> f64 {
+/// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
+/// into `lu`, factors it and returns the pivot ratio.
+fn gram(lu: &mut DenseLu, a: &[f64], rows: &[usize], n: usize) -> f64 {
     {
         let mut g = lu.matrix_mut();
-        for i in 0..rows {
-            let ri = &a[i * n..(i + 1) * n];
-            for k in 0..=i {
-                let rk = &a[k * n..(k + 1) * n];
+        for (i, &ri) in rows.iter().enumerate() {
+            let ri = &a[ri * n..(ri + 1) * n];
+            for (k, &rk) in rows[..=i].iter().enumerate() {
+                let rk = &a[rk * n..(rk + 1) * n];
                 let v: f64 = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
                 g[(i, k)] = v;
                 g[(k, i)] = v;

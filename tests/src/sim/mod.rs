@@ -10,6 +10,7 @@ mod exact;
 mod faults;
 mod models;
 mod pendulum;
+mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
