@@ -321,6 +321,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let mut qd_acc = rec.sys.qd.clone();
     let mut next_out = 0;
     let (mut last_fail_t, mut stalls) = (f64::NEG_INFINITY, 0_u32);
+    let mut pending: Option<OdeError> = None;
     let steps_mode = matches!(sim.output, Output::Steps);
 
     macro_rules! bail {
@@ -349,6 +350,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         }
         match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => {
+                pending = None;
                 if form == Formulation::Projection {
                     rec.y.copy_from_slice(stepper.y());
                     check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
@@ -393,6 +395,16 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 }
             }
             Err(e) => {
+                // After a recovery at this time, the step size that underflows on the
+                // retry is a symptom: report the kinematic failure that started it.
+                let e = match (e, pending.take()) {
+                    (OdeError::StepSizeTooSmall { t, .. }, Some(k))
+                        if k.t().is_some_and(|tk| t - tk <= STALL * span) =>
+                    {
+                        k
+                    }
+                    (e, _) => e,
+                };
                 let constraints = std::mem::take(&mut rec.sys.failure_constraints);
                 if form != Formulation::Partitioning || !recoverable(&e) {
                     bail!(SimErrorKind::from_ode(e, constraints));
@@ -420,6 +432,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 let h = stepper.h_next().abs() / 8.0;
                 let h0 = (!stepper.is_fixed_step() && h.is_finite() && h > 0.0).then_some(h);
                 check!(stepper.reset(&mut rec.sys, ta, rec.y, h0).map_err(ode));
+                rec.sys.failure_constraints = constraints;
+                pending = Some(e);
             }
         }
     }

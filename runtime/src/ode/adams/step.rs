@@ -223,7 +223,7 @@ impl Adams {
     /// attempt: undo the attempt, cut the step by [`RECOVER_FACTOR`] (no error
     /// estimate to scale by) and, from the third failure, drop to order 1 as ode.f
     /// does. Returns the failure when the step would underflow.
-    fn recover(&mut self, ifail: u32, e: OdeError) -> Result<(), OdeError> {
+    fn recover(&mut self, ifail: u32, e: OdeError) -> Result<OdeError, OdeError> {
         self.stats.rejected += 1;
         self.phase1 = false;
         self.restore();
@@ -234,7 +234,7 @@ impl Adams {
         if self.h.abs() < 4.0 * UROUND * self.x.abs() {
             return Err(e);
         }
-        Ok(())
+        Ok(e)
     }
 
     /// `STEP`: attempts until one step is accepted. `wt`, `eps` and `h` are set by the
@@ -262,6 +262,7 @@ impl Adams {
         self.c.sig[1] = 1.0;
         let saved = self.c;
         let mut ifail = 0;
+        let mut failure = None;
         let est = loop {
             if self.attempts >= self.opts.max_steps {
                 return Err(OdeError::MaxStepsExceeded {
@@ -278,7 +279,7 @@ impl Adams {
                     return Err(self.abort(saved, e));
                 }
                 ifail += 1;
-                self.recover(ifail, e)?;
+                failure = Some(self.recover(ifail, e)?);
                 continue;
             }
             let est = self.estimate();
@@ -298,10 +299,11 @@ impl Adams {
             self.h *= temp2;
             self.k = knew;
             if self.h.abs() < fouru * self.x.abs() {
-                return Err(OdeError::StepSizeTooSmall {
+                // A recoverable failure on the way down is the better report.
+                return Err(failure.unwrap_or(OdeError::StepSizeTooSmall {
                     t: self.x,
                     h: self.h,
-                });
+                }));
             }
         };
         // Block 4: correct into `y_new` (compensation term into `p`), evaluate, and
