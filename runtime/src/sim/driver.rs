@@ -7,8 +7,10 @@
 //! times the step passed (dense output, then reconstruction of the full state), update
 //! the monitors at the accepted state, run the condition monitor (partitioning) and
 //! restart on a re-partition, report progress. A failed K1 inside a step
-//! (partitioning) re-partitions at the last accepted state and restarts with an eighth
-//! of the proposed step; three failures without progress end the run.
+//! (partitioning) is first retried by the integrator with shorter steps (a recoverable
+//! failure, see `MechSystem::rhs`); if it persists, the driver re-partitions at the last
+//! accepted state and restarts with an eighth of the proposed step; three failures
+//! without progress end the run with the kinematic failure.
 //!
 //! Invariant: after the rows are reserved, the loop does not allocate unless it
 //! re-partitions or fails (the trajectory grows only in [`Output::Steps`] mode).

@@ -13,12 +13,16 @@
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix}.$$
 //! - [`Formulation::Partitioning`] (math-spec Algorithm D): the state is
 //!   $y = [p; \dot\gamma]$ with $p = [\eta; \gamma]$, of dimension
-//!   $2(n - m_h) - m_{nh}$. Each evaluation runs K1 (Newton on $\beta$ from the previous
-//!   evaluation's $\beta$ moved along $\dot\beta$ to the new time), K2 and (E31). After each accepted step the condition
-//!   monitor may re-partition; a failed Newton iteration in a step re-partitions at the
-//!   last accepted state and retries with a smaller step. Both change the meaning of
-//!   $y$, so the integrator restarts (Adams at order 1). Constraints hold to the Newton
-//!   tolerance at every evaluation: no drift.
+//!   $2(n - r) - m_{nh}$ ($r$ the rank of $C_q$, $m_h$ unless Algorithm P dropped
+//!   redundant rows). Each evaluation runs K1 (Newton on $\beta$ from the last accepted
+//!   state's $\beta$ moved along $\dot\beta$ to the new time), K2 and (E31). An
+//!   evaluation whose K1 fails or lands on another solution branch (the sign of
+//!   $\det J_d$ changed, or Newton corrected the guess by more than the predicted move)
+//!   is a recoverable failure: the integrator rejects the attempt and retries a quarter
+//!   of the step. After each accepted step the condition monitor may re-partition; a
+//!   failure that persists re-partitions at the last accepted state and retries with a
+//!   smaller step. Both change the meaning of $y$, so the integrator restarts (Adams at
+//!   order 1). Constraints hold to the Newton tolerance at every evaluation: no drift.
 //! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
 //!   step $q$ is projected onto $C(q,t) = 0$ by Newton with minimum-norm corrections
 //!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and $\dot q$ onto
