@@ -386,7 +386,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                         .monitor(mech, &mut sys.ws, t, &sys.q)
                         .map_err(|e| analysis(e.into())));
                     check!(rec.sys.accept(t).map_err(analysis));
-                    if moved && t < t_end && rec.sys.update_indices() {
+                    let changed = moved && t < t_end && rec.sys.update_indices();
+                    if rec.sys.rank_changed {
+                        bail!(rank_changed(&rec.sys, t));
+                    }
+                    if changed {
                         check!(rec.sys.accept(t).map_err(analysis));
                         rec.sys.gather(rec.y);
                         check!(stepper.reset(&mut rec.sys, t, rec.y, None).map_err(ode));
@@ -429,6 +433,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                     bail!(SimErrorKind::from_ode(e, constraints));
                 }
                 rec.sys.update_indices();
+                if rec.sys.rank_changed {
+                    bail!(rank_changed(&rec.sys, ta));
+                }
                 check!(rec.sys.accept(ta).map_err(analysis));
                 rec.sys.gather(rec.y);
                 let h = stepper.h_next().abs() / 8.0;
@@ -461,6 +468,28 @@ fn assembly_error(e: AssemblyError) -> SimErrorKind {
     match eval {
         Some(v @ EvalError::NonFinite { .. }) => SimErrorKind::from_eval(v.clone()),
         _ => SimErrorKind::Assembly(e),
+    }
+}
+
+/// The rank of $C_q$ changed at a re-partition (redundant constraints that stop being
+/// redundant, or new ones): the motion went through a singular configuration.
+fn rank_changed<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>, t: f64) -> SimErrorKind {
+    let info = sys.info;
+    let constraints = sys
+        .kin
+        .partition()
+        .map(|p| {
+            p.redundant_rows()
+                .iter()
+                .map(|&i| info.holonomic[i].name)
+                .collect()
+        })
+        .unwrap_or_default();
+    SimErrorKind::Singular {
+        t,
+        matrix: super::SingularMatrix::DependentPositions,
+        ratio: 0.0,
+        constraints,
     }
 }
 

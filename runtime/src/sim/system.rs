@@ -78,6 +78,8 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     retries: u32,
     /// Whether `q_acc`, `qd_acc` hold an accepted state.
     anchored: bool,
+    /// A re-partition found another rank of $C_q$ than the first partition.
+    pub rank_changed: bool,
     /// Partitioning, the last K1: its guess, the largest move of a coordinate from the
     /// base state to the guess, and the largest Newton correction of the guess.
     guess: Vec<f64>,
@@ -140,6 +142,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             sign_acc: 0.0,
             retries: 0,
             anchored: false,
+            rank_changed: false,
             guess: vec![0.0; n],
             moved: 0.0,
             correction: 0.0,
@@ -186,6 +189,12 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .partition()
             .expect("partitioning keeps a partition");
         let (eta, ind) = (p.dependent_velocity(), p.independent());
+        if !self.coords.is_empty() && self.coords.len() != eta.len() + ind.len() {
+            // The rank of C_q changed (a redundant row became independent or the
+            // reverse): the state would change dimension. The driver reports it.
+            self.rank_changed = true;
+            return false;
+        }
         let same = self.coords.len() == eta.len() + ind.len()
             && self.coords[..eta.len()] == *eta
             && self.coords[eta.len()..] == *ind;
