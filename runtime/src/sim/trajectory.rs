@@ -202,7 +202,7 @@ pub struct Run {
     /// assembly, or else by the acceleration solve; which rows of a dependent set get
     /// named depends on the pivoting). Their multipliers are the minimum-norm split,
     /// their small inconsistencies from drift are solved in the least-squares sense
-    /// (see [`crate::dynamics`]), and K1, K2 and the projection use the other rows.
+    /// (see [`Dynamics`](crate::Dynamics)), and K1, K2 and the projection use the other rows.
     pub redundant_constraints: Vec<&'static str>,
 }
 
