@@ -22,8 +22,13 @@
 //! $J^\mathsf{T}\lambda = J_R^\mathsf{T}\lambda_R$ satisfies $T^\mathsf{T}\lambda =
 //! \lambda_R$, and the one of least 2-norm is
 //! $\lambda = T (T^\mathsf{T}T)^{-1}\lambda_R$ (for a duplicated row: an equal
-//! split). The redundant rows' $\gamma$ must agree with $\ddot q$, otherwise
-//! [`DynamicsError::InconsistentRedundant`].
+//! split). The redundant rows' $\gamma$ must agree with $\ddot q$ up to
+//! [`DynamicsParams::redundant_tolerance`], otherwise
+//! [`DynamicsError::InconsistentRedundant`]. Within it, $\ddot q$ meets the
+//! independent rows exactly and the redundant ones in the least-squares sense of the
+//! drift that made them disagree: a state off the constraint manifold by $\delta$
+//! leaves $J_D\ddot q - \gamma_D = O(\delta)$, which no choice of $\ddot q$ can remove
+//! without violating an independent row.
 //!
 //! Invariant: the dense and sparse paths do not allocate after the first call; the
 //! redundant path allocates.
@@ -62,6 +67,14 @@ pub struct DynamicsParams {
     /// Relative residual above which a sparse solution is rejected (then the redundant
     /// path runs).
     pub residual_tolerance: f64,
+    /// Relative residual of the redundant rows, $\max_D|J_D\ddot q - \gamma_D|$ over
+    /// $\max_D(\lVert J_D\rVert\lVert\ddot q\rVert + |\gamma_D|)$, above which
+    /// they count as inconsistent ([`DynamicsError::InconsistentRedundant`]). Below it
+    /// the solution is the least-squares one described in the module docs. A kinematic
+    /// analysis at an exact configuration keeps the default $10^{-8}$; a simulation,
+    /// whose state drifts off the constraints by the integration error, raises it to
+    /// match (see [`crate::sim`]).
+    pub redundant_tolerance: f64,
 }
 
 impl Default for DynamicsParams {
@@ -71,6 +84,7 @@ impl Default for DynamicsParams {
             crossover: DEFAULT_CROSSOVER,
             rank_tolerance: 1e-10,
             residual_tolerance: 1e-10,
+            redundant_tolerance: 1e-8,
         }
     }
 }
@@ -358,7 +372,9 @@ impl Dynamics {
             residual = residual.max((dot(jd, qdd) - self.b[n + d]).abs());
             scale = scale.max(inf_norm(jd) * inf_norm(qdd) + self.b[n + d].abs());
         }
-        if residual.is_nan() || residual > 1e-8 * scale.max(f64::MIN_POSITIVE) {
+        if residual.is_nan()
+            || residual > self.params.redundant_tolerance * scale.max(f64::MIN_POSITIVE)
+        {
             return Err(DynamicsError::InconsistentRedundant {
                 t,
                 constraints: self.redundant_constraints().collect(),

@@ -98,6 +98,19 @@ pub enum KinematicsError {
         ratio: f64,
     },
     /// Algorithm P failed.
+    /// K1 converged, but to another solution branch than the reference state's: the
+    /// sign of $\det J_d$ differs from the reference (see
+    /// [`Kinematics::dependent_sign`]), or the correction of the guess exceeds the
+    /// predicted motion. Detected by the simulation: the guess was extrapolated too far.
+    #[error("position analysis at t = {t} converged on another solution branch; a shorter step is needed")]
+    BranchSwitch {
+        /// Time.
+        t: f64,
+        /// Newton iterations performed.
+        iterations: usize,
+        /// Final $\lVert C\rVert_\infty$.
+        residual: f64,
+    },
     #[error(transparent)]
     Partition(#[from] PartitionError),
     /// Evaluation failed.
@@ -119,6 +132,7 @@ pub struct Kinematics {
     repartitions: usize,
     history: Vec<f64>,
     rhs: Vec<f64>,
+    sign: f64,
 }
 
 impl Kinematics {
@@ -135,6 +149,7 @@ impl Kinematics {
             repartitions: 0,
             history: Vec::with_capacity(params.newton.max_iterations + 1),
             rhs: vec![0.0; m],
+            sign: 0.0,
         }
     }
 
@@ -163,6 +178,20 @@ impl Kinematics {
 
     /// $\lVert C\rVert_\infty$ after each iteration of the last K1 solve (the first
     /// entry is the initial residual).
+    /// The sign of $\det J_d$ (E34) at the last K2, in the column order of the current
+    /// partition ($0$ before any K2 or when singular).
+    ///
+    /// Along a motion with a fixed partition $J_d$ stays non-singular, so its
+    /// determinant keeps its sign; the mirror-image assembly of a loop (the other root
+    /// of K1 for the same $p$) lies across the singular set $\det C_\beta = 0$ and has
+    /// the opposite sign for the usual fold between two branches. A change of sign
+    /// between two nearby states therefore means that K1 jumped branches or the
+    /// motion crossed a singular configuration: either way the step was too long.
+    #[must_use]
+    pub fn dependent_sign(&self) -> f64 {
+        self.sign
+    }
+
     #[must_use]
     pub fn residual_history(&self) -> &[f64] {
         &self.history
@@ -265,18 +294,21 @@ impl Kinematics {
         let info = ws.info();
         check_state(info, t, q, None)?;
         self.ensure_partition(mech, ws, t, q)?;
-        let (n, mh) = (info.nq(), info.nh());
+        let n = info.nq();
         let Self {
             params,
             lu_h,
             partition,
             history,
+            rhs,
             ..
         } = self;
-        let beta = &partition
-            .as_ref()
-            .expect("partition ensured above")
-            .dependent;
+        let p = partition.as_ref().expect("partition ensured above");
+        let (beta, rows) = (&p.dependent, &p.rows);
+        if lu_h.dim() != rows.len() {
+            // Redundant rows dropped: a smaller block (allocates at a re-partition only).
+            *lu_h = DenseLu::new(rows.len(), 1);
+        }
         let tol = params.newton.tolerance;
         history.clear();
         ws.eval_constraints(mech, t, q)?;
@@ -295,9 +327,9 @@ impl Kinematics {
             ws.eval_jacobian(mech, t, q)?;
             {
                 let mut a = lu_h.matrix_mut();
-                for i in 0..mh {
+                for (r, &i) in rows.iter().enumerate() {
                     for (k, &j) in beta.iter().enumerate() {
-                        a[(i, k)] = ws.jacobian[i * n + j];
+                        a[(r, k)] = ws.jacobian[i * n + j];
                     }
                 }
             }
@@ -309,9 +341,9 @@ impl Kinematics {
                     ratio,
                 });
             }
-            let dx = &mut ws.c;
-            for v in dx.iter_mut() {
-                *v = -*v;
+            let dx = &mut rhs[..rows.len()];
+            for (v, &i) in dx.iter_mut().zip(rows) {
+                *v = -ws.c[i];
             }
             lu_h.solve_vec(dx);
             step = 0.0;
@@ -374,28 +406,37 @@ impl Kinematics {
             lu_d,
             partition,
             rhs,
+            sign,
             ..
         } = self;
         let p = partition.as_ref().expect("partition ensured above");
         let dep = || p.dependent.iter().chain(&p.eta);
+        // The rows of J_d: the holonomic rows of β (all unless redundant ones were
+        // dropped), then the non-holonomic ones.
+        let rows = || p.rows.iter().copied().chain(mh..m);
+        let md = p.rows.len() + (m - mh);
+        if lu_d.dim() != md {
+            *lu_d = DenseLu::new(md, 1);
+        }
         {
             let mut a = lu_d.matrix_mut();
-            for i in 0..m {
+            for (r, i) in rows().enumerate() {
                 for (k, &j) in dep().enumerate() {
-                    a[(i, k)] = ws.jacobian[i * n + j];
+                    a[(r, k)] = ws.jacobian[i * n + j];
                 }
             }
         }
-        for (i, r) in rhs.iter_mut().enumerate() {
+        for (r, i) in rhs[..md].iter_mut().zip(rows()) {
             let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
             let row = &ws.jacobian[i * n..(i + 1) * n];
             *r = -c - p.independent.iter().map(|&j| row[j] * qd[j]).sum::<f64>();
         }
         let ratio = lu_d.factor().ratio();
+        *sign = lu_d.det_sign();
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(KinematicsError::SingularVelocity { t, ratio });
         }
-        lu_d.solve_vec(rhs);
+        lu_d.solve_vec(&mut rhs[..md]);
         for (k, j) in dep().enumerate() {
             qd[*j] = rhs[k];
         }

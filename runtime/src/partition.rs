@@ -36,6 +36,12 @@ pub struct PartitionParams {
     /// Re-partition when a pivot ratio falls below this fraction of its value at
     /// partition time.
     pub deterioration: f64,
+    /// Accept redundant holonomic constraints: the rows left without a pivot are
+    /// dropped from $\beta$'s equations ([`Partition::redundant_rows`]) instead of
+    /// failing with [`PartitionError::RedundantHolonomic`]. Near the constraint
+    /// manifold the independent rows have the same solution set, so K1 and K2 on them
+    /// satisfy the dropped rows too. Not with non-holonomic constraints.
+    pub allow_redundant: bool,
 }
 
 impl Default for PartitionParams {
@@ -43,6 +49,7 @@ impl Default for PartitionParams {
         Self {
             pivot_tolerance: 1e-9,
             deterioration: 1e-3,
+            allow_redundant: false,
         }
     }
 }
@@ -135,6 +142,10 @@ pub struct Partition {
     pub(crate) dependent: Vec<usize>,
     pub(crate) eta: Vec<usize>,
     pub(crate) independent: Vec<usize>,
+    /// The holonomic rows that determine $\beta$ (all of them, in order, unless
+    /// redundant rows were dropped) and the dropped ones.
+    pub(crate) rows: Vec<usize>,
+    pub(crate) redundant: Vec<usize>,
     pub(crate) reference: Condition,
     pub(crate) abs_det: f64,
     pub(crate) time: f64,
@@ -160,6 +171,19 @@ impl Partition {
     #[must_use]
     pub fn dependent(&self) -> &[usize] {
         &self.dependent
+    }
+
+    /// The holonomic constraints (row indices) whose equations determine $\beta$.
+    #[must_use]
+    pub fn holonomic_rows(&self) -> &[usize] {
+        &self.rows
+    }
+
+    /// The redundant holonomic constraints (row indices) left out of K1 and K2 (empty
+    /// unless [`PartitionParams::allow_redundant`]).
+    #[must_use]
+    pub fn redundant_rows(&self) -> &[usize] {
+        &self.redundant
     }
 
     /// $\eta$: independent coordinates with dependent velocities.
@@ -269,6 +293,27 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         elim.tier[i] = Tier::Allowed;
     }
     let ph1 = elim.phase(0, mh, mh, params.pivot_tolerance);
+    if ph1.rank < mh && params.allow_redundant && m == mh && ph1.first_allowed.is_none() {
+        let r = ph1.rank;
+        let mut rows = elim.rows[..r].to_vec();
+        let mut redundant = elim.rows[r..mh].to_vec();
+        rows.sort_unstable();
+        redundant.sort_unstable();
+        return Ok(Partition {
+            info,
+            dependent: elim.cols[..r].to_vec(),
+            eta: Vec::new(),
+            independent: elim.cols[r..n].to_vec(),
+            rows,
+            redundant,
+            reference: Condition {
+                holonomic: ph1.ratio(r),
+                nonholonomic: 1.0,
+            },
+            abs_det: ph1.abs_det,
+            time: t,
+        });
+    }
     if ph1.rank < mh {
         return Err(PartitionError::RedundantHolonomic {
             t,
@@ -330,6 +375,8 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         dependent: elim.cols[..mh].to_vec(),
         eta: elim.cols[mh..m].to_vec(),
         independent: elim.cols[m..n].to_vec(),
+        rows: (0..mh).collect(),
+        redundant: Vec::new(),
         reference: Condition {
             holonomic: ph1.ratio(mh),
             nonholonomic: ph2.ratio(m - mh),
@@ -357,9 +404,10 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
     for &i in &partition.dependent {
         elim.tier[i] = Tier::Preferred;
     }
-    let ph1 = elim.phase(0, mh, mh, 0.0);
-    let holonomic = ph1.ratio(mh);
-    if ph1.rank < mh {
+    let r = partition.dependent.len();
+    let ph1 = elim.phase(0, mh, r, 0.0);
+    let holonomic = ph1.ratio(r);
+    if ph1.rank < r {
         return Ok(Condition {
             holonomic,
             nonholonomic: 0.0,

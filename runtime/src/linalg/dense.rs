@@ -109,6 +109,24 @@ impl DenseLu {
         Pivots { max, min }
     }
 
+    /// The sign of $\det A$ from the last factorization: the product of the signs of
+    /// the pivots and of the two permutations ($0$ when a pivot is zero or NaN).
+    pub fn det_sign(&self) -> f64 {
+        let n = self.n;
+        let mut sign = 1.0;
+        for k in 0..n {
+            let u = self.a[(k, k)];
+            if u == 0.0 || u.is_nan() {
+                return 0.0;
+            }
+            sign *= u.signum();
+        }
+        if odd(&self.row_fwd) != odd(&self.col_fwd) {
+            sign = -sign;
+        }
+        sign
+    }
+
     /// Solves $A X = B$ in place with the last factorization; `rhs` is `n × k`,
     /// `k ≤ rhs_cols`.
     pub fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) {
@@ -133,5 +151,55 @@ impl DenseLu {
     pub fn solve_vec(&mut self, b: &mut [f64]) {
         let n = self.n;
         self.solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
+    }
+}
+
+/// Whether a permutation is odd: $n$ minus its number of cycles, each cycle counted at
+/// its smallest index (quadratic, but allocation-free; the matrices are small).
+fn odd(perm: &[usize]) -> bool {
+    let mut transpositions = 0;
+    for (i, &first) in perm.iter().enumerate() {
+        let mut j = first;
+        let mut smallest = true;
+        let mut len = 1;
+        while j != i {
+            if j < i {
+                smallest = false;
+                break;
+            }
+            j = perm[j];
+            len += 1;
+        }
+        if smallest {
+            transpositions += len - 1;
+        }
+    }
+    transpositions % 2 == 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn det_sign_follows_the_determinant() {
+        // det = 0*… : a permuted matrix with det -6 and one with det +6.
+        for (entries, expected) in [
+            ([[0.0, 2.0, 0.0], [3.0, 0.0, 0.0], [0.0, 0.0, 1.0]], -1.0),
+            ([[0.0, 2.0, 0.0], [0.0, 0.0, 3.0], [1.0, 0.0, 0.0]], 1.0),
+            ([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 10.0]], -1.0),
+        ] {
+            let mut lu = DenseLu::new(3, 1);
+            {
+                let mut a = lu.matrix_mut();
+                for (i, row) in entries.iter().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
+                        a[(i, j)] = *v;
+                    }
+                }
+            }
+            lu.factor();
+            assert_eq!(lu.det_sign(), expected, "{entries:?}");
+        }
     }
 }

@@ -61,6 +61,25 @@ pub(crate) fn eval<S: OdeSystem + ?Sized>(
     }
 }
 
+/// Whether an error only rejects the step attempt: a recoverable failure of the
+/// right-hand side (see [`RhsError::recoverable`](super::RhsError::recoverable)).
+#[inline]
+pub(crate) fn is_recoverable(e: &OdeError) -> bool {
+    matches!(e, OdeError::Rhs { source, .. } if source.is_recoverable())
+}
+
+/// Step-size factor after a recoverable failure of the right-hand side: as after a
+/// Newton failure in implicit codes (Hairer's `RADAU5` halves, DASSL quarters), a
+/// drastic cut, since the failure carries no error estimate to scale by.
+pub(crate) const RECOVER_FACTOR: f64 = 0.25;
+
+/// Whether a step of size `h` from `t` is below what `t` can resolve (Hairer's rule
+/// $0.1|h| \le |t|\,u$).
+#[inline]
+pub(crate) fn underflows(t: f64, h: f64) -> bool {
+    0.1 * h.abs() <= t.abs() * UROUND
+}
+
 /// The mixed RMS norm of a local error estimate `err`,
 /// $\sqrt{\frac1n\sum_i (e_i/s_i)^2}$ with $s_i = \text{atol}_i + \text{rtol}\max(|y_i|, |\hat y_i|)$.
 #[inline]
@@ -103,7 +122,13 @@ pub(crate) fn hinit<S: OdeSystem + ?Sized>(
     for i in 0..y.len() {
         y1[i] = y[i] + h * f0[i];
     }
-    eval(sys, stats, t + h, y1, f1)?;
+    if let Err(e) = eval(sys, stats, t + h, y1, f1) {
+        if !is_recoverable(&e) {
+            return Err(e);
+        }
+        // The explicit Euler step went too far for the system: start below it.
+        return Ok(h * RECOVER_FACTOR);
+    }
     let mut der2 = 0.0;
     for i in 0..y.len() {
         der2 += ((f1[i] - f0[i]) / sk(i)).powi(2);

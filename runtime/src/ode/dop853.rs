@@ -18,8 +18,8 @@
 //! $\text{fac}_1 = 0.333$, $\text{fac}_2 = 6$, exponent $1/8$.
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, hinit, limit_to_stop, PiController,
-    UROUND,
+    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop,
+    underflows, PiController, RECOVER_FACTOR,
 };
 use super::dop853_tableau::{A, BHH, C, D, ER};
 use super::error::OdeError;
@@ -156,6 +156,20 @@ impl Dop853 {
         Ok(h.abs() * e5 * (1.0 / (self.y.len() as f64 * deno)).sqrt())
     }
 
+    /// After a failed attempt of size `h`: a recoverable failure of the right-hand side
+    /// counts as a rejection and cuts the step by [`RECOVER_FACTOR`] (the failure is
+    /// handed back, to be reported if the step size underflows later); any other
+    /// error, or a step that would underflow, is returned as the error.
+    fn recover(&mut self, e: OdeError, h: f64) -> Result<OdeError, OdeError> {
+        let h_new = h * RECOVER_FACTOR;
+        if !is_recoverable(&e) || underflows(self.t, h_new) {
+            return Err(e);
+        }
+        self.stats.rejected += 1;
+        self.h = h_new;
+        Ok(e)
+    }
+
     /// Evaluates the three extra stages and stores the interpolant of the accepted step
     /// (before `y` is replaced; `k[FSAL]` must hold $f(t+h, y_{n+1})$).
     fn store_dense<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<(), OdeError> {
@@ -252,6 +266,7 @@ impl Integrator for Dop853 {
             self.fsal = true;
         }
         let mut rejected = false;
+        let mut failure = None;
         loop {
             if self.attempts >= self.opts.max_steps {
                 return Err(OdeError::MaxStepsExceeded {
@@ -261,11 +276,19 @@ impl Integrator for Dop853 {
             }
             let h = self.dir * self.h.abs().min(self.opts.h_max);
             let (h, hits) = limit_to_stop(self.t, h, t_stop);
-            if !hits && 0.1 * h.abs() <= self.t.abs() * UROUND {
-                return Err(OdeError::StepSizeTooSmall { t: self.t, h });
+            if !hits && underflows(self.t, h) {
+                // A recoverable failure on the way down is the better report.
+                return Err(failure.unwrap_or(OdeError::StepSizeTooSmall { t: self.t, h }));
             }
             self.attempts += 1;
-            let err = self.attempt(sys, h)?;
+            let err = match self.attempt(sys, h) {
+                Ok(err) => err,
+                Err(e) => {
+                    failure = Some(self.recover(e, h)?);
+                    rejected = true;
+                    continue;
+                }
+            };
             let (h_new, accepted) = self.ctrl.control(err, h);
             if !accepted {
                 rejected = true;
@@ -281,11 +304,18 @@ impl Integrator for Dop853 {
                 (true, Some(ts)) => ts,
                 _ => self.t + h,
             };
-            eval(sys, &mut self.stats, t_new, &self.y_new, &mut self.k[FSAL])?;
+            let mut fsal = eval(sys, &mut self.stats, t_new, &self.y_new, &mut self.k[FSAL]);
             self.dense_ready = false;
-            if self.opts.dense_output {
-                self.store_dense(sys, h)?;
-                self.dense_ready = true;
+            if fsal.is_ok() && self.opts.dense_output {
+                fsal = self.store_dense(sys, h);
+                self.dense_ready = fsal.is_ok();
+            }
+            if let Err(e) = fsal {
+                // The new state or a dense-output stage failed recoverably: the
+                // attempt is rejected like one with a large error.
+                failure = Some(self.recover(e, h)?);
+                rejected = true;
+                continue;
             }
             std::mem::swap(&mut self.y, &mut self.y_new);
             self.k.swap(0, FSAL);

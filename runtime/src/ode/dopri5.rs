@@ -17,8 +17,8 @@
 //! [`Tolerances`]: super::Tolerances
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, hinit, limit_to_stop, rms_norm,
-    PiController, UROUND,
+    check_in_step, check_len, check_state, check_stop, eval, hinit, is_recoverable, limit_to_stop,
+    rms_norm, underflows, PiController, RECOVER_FACTOR,
 };
 use super::error::OdeError;
 use super::integrator::Integrator;
@@ -116,6 +116,20 @@ impl Dopri5 {
     /// The options in use.
     pub fn options(&self) -> &OdeOptions {
         &self.opts
+    }
+
+    /// After a failed attempt of size `h`: a recoverable failure of the right-hand side
+    /// counts as a rejection and cuts the step by [`RECOVER_FACTOR`] (the failure is
+    /// handed back, to be reported if the step size underflows later); any other
+    /// error, or a step that would underflow, is returned as the error.
+    fn recover(&mut self, e: OdeError, h: f64) -> Result<OdeError, OdeError> {
+        let h_new = h * RECOVER_FACTOR;
+        if !is_recoverable(&e) || underflows(self.t, h_new) {
+            return Err(e);
+        }
+        self.stats.rejected += 1;
+        self.h = h_new;
+        Ok(e)
     }
 
     /// One attempt of size `h`: stages 2–7 into `k`, $y_{n+1}$ into `y_new`; returns
@@ -246,6 +260,7 @@ impl Integrator for Dopri5 {
             self.fsal = true;
         }
         let mut rejected = false;
+        let mut failure = None;
         loop {
             if self.attempts >= self.opts.max_steps {
                 return Err(OdeError::MaxStepsExceeded {
@@ -255,11 +270,19 @@ impl Integrator for Dopri5 {
             }
             let h = self.dir * self.h.abs().min(self.opts.h_max);
             let (h, hits) = limit_to_stop(self.t, h, t_stop);
-            if !hits && 0.1 * h.abs() <= self.t.abs() * UROUND {
-                return Err(OdeError::StepSizeTooSmall { t: self.t, h });
+            if !hits && underflows(self.t, h) {
+                // A recoverable failure on the way down is the better report.
+                return Err(failure.unwrap_or(OdeError::StepSizeTooSmall { t: self.t, h }));
             }
             self.attempts += 1;
-            let err = self.attempt(sys, h)?;
+            let err = match self.attempt(sys, h) {
+                Ok(err) => err,
+                Err(e) => {
+                    failure = Some(self.recover(e, h)?);
+                    rejected = true;
+                    continue;
+                }
+            };
             let (h_new, accepted) = self.ctrl.control(err, h);
             if !accepted {
                 rejected = true;

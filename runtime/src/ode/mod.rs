@@ -4,7 +4,9 @@
 //! dense output on the last step, work counters.
 //! Invariants: no integrator allocates while stepping (all scratch is sized by the
 //! constructor); every NaN or infinity is reported as [`OdeError::NonFinite`]; after any
-//! error the last accepted state stays readable.
+//! error the last accepted state stays readable; a
+//! [recoverable](RhsError::recoverable) failure of the right-hand side rejects the
+//! attempt and shortens the step, and is returned only when the step size underflows.
 //!
 //! | integrator | method | error control | dense output |
 //! |---|---|---|---|

@@ -4,8 +4,11 @@
 //! $h$ per call (the last one shortened, or stretched by at most $10^{-10}h$ against
 //! round-off, to end exactly on `t_stop`), with a third-order dense output built from
 //! the four stage values.
-//! Invariants: exactly four evaluations of the right-hand side per step and none at
-//! reset; no error control; no allocation after construction.
+//! Invariants: four evaluations of the right-hand side per step and none at reset; no
+//! error control, but a recoverable failure of the right-hand side
+//! ([`RhsError::recoverable`](super::RhsError::recoverable)) halves this one step
+//! (counted as a rejection) until it succeeds or underflows; no allocation after
+//! construction.
 //!
 //! $$k_1 = f(t, y),\; k_2 = f(t+\tfrac h2, y+\tfrac h2 k_1),\;
 //! k_3 = f(t+\tfrac h2, y+\tfrac h2 k_2),\; k_4 = f(t+h, y+hk_3),$$
@@ -14,7 +17,9 @@
 //! h\sum_i b_i(\theta)k_i$ with $b_1 = \theta - \frac32\theta^2 + \frac23\theta^3$,
 //! $b_2 = b_3 = \theta^2 - \frac23\theta^3$, $b_4 = -\frac12\theta^2 + \frac23\theta^3$.
 
-use super::common::{check_in_step, check_len, check_state, check_stop, eval};
+use super::common::{
+    check_in_step, check_len, check_state, check_stop, eval, is_recoverable, underflows,
+};
 use super::error::OdeError;
 use super::integrator::Integrator;
 use super::options::{check_h0, OdeStats};
@@ -74,6 +79,30 @@ impl Rk4 {
     pub fn h(&self) -> f64 {
         self.h
     }
+    /// One step of size `h` from the current state into `tmp` (stages into `k`).
+    fn attempt<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<(), OdeError> {
+        let t = self.t;
+        let n = self.dim();
+        let [k1, k2, k3, k4] = &mut self.k;
+        let (y, tmp) = (&self.y, &mut self.tmp);
+        eval(sys, &mut self.stats, t, y, k1)?;
+        for i in 0..n {
+            tmp[i] = y[i] + 0.5 * h * k1[i];
+        }
+        eval(sys, &mut self.stats, t + 0.5 * h, tmp, k2)?;
+        for i in 0..n {
+            tmp[i] = y[i] + 0.5 * h * k2[i];
+        }
+        eval(sys, &mut self.stats, t + 0.5 * h, tmp, k3)?;
+        for i in 0..n {
+            tmp[i] = y[i] + h * k3[i];
+        }
+        eval(sys, &mut self.stats, t + h, tmp, k4)?;
+        for i in 0..n {
+            tmp[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+        Ok(())
+    }
 }
 
 impl Integrator for Rk4 {
@@ -124,29 +153,23 @@ impl Integrator for Rk4 {
             });
         }
         let t = self.t;
-        let (h, hits) = match t_stop {
+        let (mut h, mut hits) = match t_stop {
             Some(ts) if (ts - t).abs() <= self.h.abs() * (1.0 + 1e-10) => (ts - t, true),
             _ => (self.h, false),
         };
-        let n = self.dim();
-        let [k1, k2, k3, k4] = &mut self.k;
-        let (y, tmp) = (&self.y, &mut self.tmp);
-        eval(sys, &mut self.stats, t, y, k1)?;
-        for i in 0..n {
-            tmp[i] = y[i] + 0.5 * h * k1[i];
+        loop {
+            match self.attempt(sys, h) {
+                Ok(()) => break,
+                Err(e) if is_recoverable(&e) && !underflows(t, 0.5 * h) => {
+                    // Shorten this step only; the next one has the nominal size again.
+                    self.stats.rejected += 1;
+                    h *= 0.5;
+                    hits = false;
+                }
+                Err(e) => return Err(e),
+            }
         }
-        eval(sys, &mut self.stats, t + 0.5 * h, tmp, k2)?;
-        for i in 0..n {
-            tmp[i] = y[i] + 0.5 * h * k2[i];
-        }
-        eval(sys, &mut self.stats, t + 0.5 * h, tmp, k3)?;
-        for i in 0..n {
-            tmp[i] = y[i] + h * k3[i];
-        }
-        eval(sys, &mut self.stats, t + h, tmp, k4)?;
-        for i in 0..n {
-            tmp[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
+        let tmp = &self.tmp;
         let t_new = if hits { t_stop.unwrap_or(t + h) } else { t + h };
         check_state(t_new, tmp)?;
         self.y_prev.copy_from_slice(&self.y);

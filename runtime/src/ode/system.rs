@@ -38,8 +38,13 @@ pub trait OdeSystem {
     ///
     /// # Errors
     /// Any failure of the model (a Newton iteration that did not converge, a singular
-    /// matrix), wrapped with [`RhsError::new`]. The integrator stops and returns it
-    /// unchanged inside [`OdeError::Rhs`](crate::ode::OdeError::Rhs).
+    /// matrix), wrapped with [`RhsError::new`]: the integrator stops and returns it
+    /// unchanged inside [`OdeError::Rhs`](crate::ode::OdeError::Rhs). A failure wrapped
+    /// with [`RhsError::recoverable`] instead rejects the step attempt: the adaptive
+    /// integrators retry with a quarter of the step (counted in
+    /// [`OdeStats::rejected`](crate::ode::OdeStats::rejected)), [`Rk4`](crate::ode::Rk4)
+    /// shortens the step by halves, and the error is returned only when the step size
+    /// underflows.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError>;
 }
 
@@ -66,12 +71,31 @@ pub trait OdeSystem {
 /// assert_eq!(e.to_string(), "singular pivot 3");
 /// assert_eq!(e.downcast::<Singular>().unwrap(), Singular(3));
 /// ```
-pub struct RhsError(Box<dyn Error + Send + Sync + 'static>);
+pub struct RhsError(Box<dyn Error + Send + Sync + 'static>, bool);
 
 impl RhsError {
-    /// Wraps a typed error of the system.
+    /// Wraps a typed error of the system: the integration stops.
     pub fn new<E: Error + Send + Sync + 'static>(error: E) -> Self {
-        Self(Box::new(error))
+        Self(Box::new(error), false)
+    }
+
+    /// Wraps a typed error of the system that a shorter step may avoid (a Newton
+    /// iteration that diverged or converged to another solution branch from a guess
+    /// extrapolated too far): the integrator rejects the attempt and retries smaller.
+    ///
+    /// ```
+    /// use pfaff::ode::RhsError;
+    ///
+    /// assert!(RhsError::recoverable(std::fmt::Error).is_recoverable());
+    /// assert!(!RhsError::new(std::fmt::Error).is_recoverable());
+    /// ```
+    pub fn recoverable<E: Error + Send + Sync + 'static>(error: E) -> Self {
+        Self(Box::new(error), true)
+    }
+
+    /// Whether the failure only rejects the step attempt (see [`recoverable`](Self::recoverable)).
+    pub fn is_recoverable(&self) -> bool {
+        self.1
     }
 
     /// Whether the wrapped error has type `E`.
@@ -89,7 +113,11 @@ impl RhsError {
     /// # Errors
     /// Returns `self` when the wrapped error is not an `E`.
     pub fn downcast<E: Error + 'static>(self) -> Result<E, Self> {
-        self.0.downcast::<E>().map(|b| *b).map_err(Self)
+        let retry = self.1;
+        self.0
+            .downcast::<E>()
+            .map(|b| *b)
+            .map_err(|e| Self(e, retry))
     }
 
     /// The wrapped error as a trait object.
@@ -100,19 +128,19 @@ impl RhsError {
 
 impl From<Box<dyn Error + Send + Sync + 'static>> for RhsError {
     fn from(error: Box<dyn Error + Send + Sync + 'static>) -> Self {
-        Self(error)
+        Self(error, false)
     }
 }
 
 impl From<String> for RhsError {
     fn from(message: String) -> Self {
-        Self(message.into())
+        Self(message.into(), false)
     }
 }
 
 impl From<&str> for RhsError {
     fn from(message: &str) -> Self {
-        Self(message.into())
+        Self(message.into(), false)
     }
 }
 

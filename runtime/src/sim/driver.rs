@@ -7,8 +7,10 @@
 //! times the step passed (dense output, then reconstruction of the full state), update
 //! the monitors at the accepted state, run the condition monitor (partitioning) and
 //! restart on a re-partition, report progress. A failed K1 inside a step
-//! (partitioning) re-partitions at the last accepted state and restarts with an eighth
-//! of the proposed step; three failures without progress end the run.
+//! (partitioning) is first retried by the integrator with shorter steps (a recoverable
+//! failure, see `MechSystem::rhs`); if it persists, the driver re-partitions at the last
+//! accepted state and restarts with an eighth of the proposed step; three failures
+//! without progress end the run with the kinematic failure.
 //!
 //! Invariant: after the rows are reserved, the loop does not allocate unless it
 //! re-partitions or fails (the trajectory grows only in [`Output::Steps`] mode).
@@ -158,6 +160,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             trajectory: self.traj.clone(),
             stats,
             monitors: self.monitors,
+            redundant_constraints: self.sys.redundant.clone(),
         }
     }
 
@@ -183,6 +186,7 @@ fn recoverable(e: &OdeError) -> bool {
             source.downcast_ref::<Error>(),
             Some(Error::Kinematics(
                 KinematicsError::NewtonFailed { .. }
+                    | KinematicsError::BranchSwitch { .. }
                     | KinematicsError::SingularDependent { .. }
                     | KinematicsError::SingularVelocity { .. }
             ))
@@ -211,6 +215,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 ..Stats::default()
             },
             monitors: Monitors::default(),
+            redundant_constraints: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -257,10 +262,14 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
     sys.t_state = t0;
+    sys.redundant = sys.fit_rows();
     if form == Formulation::Partitioning {
         // Assembly left its partition current: Algorithm P with the prescribed
         // coordinates kept independent (exactly Algorithm P without a prescription).
         sys.update_indices();
+        if let Err(e) = sys.accept(t0) {
+            return Err(empty(SimErrorKind::from_analysis(e, Vec::new())));
+        }
     }
 
     let rows = match sim.output {
@@ -314,6 +323,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let mut qd_acc = rec.sys.qd.clone();
     let mut next_out = 0;
     let (mut last_fail_t, mut stalls) = (f64::NEG_INFINITY, 0_u32);
+    let mut pending: Option<OdeError> = None;
     let steps_mode = matches!(sim.output, Output::Steps);
 
     macro_rules! bail {
@@ -342,6 +352,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         }
         match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => {
+                pending = None;
                 if form == Formulation::Projection {
                     rec.y.copy_from_slice(stepper.y());
                     check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
@@ -374,7 +385,13 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                         .kin
                         .monitor(mech, &mut sys.ws, t, &sys.q)
                         .map_err(|e| analysis(e.into())));
-                    if moved && t < t_end && rec.sys.update_indices() {
+                    check!(rec.sys.accept(t).map_err(analysis));
+                    let changed = moved && t < t_end && rec.sys.update_indices();
+                    if rec.sys.rank_changed {
+                        bail!(rank_changed(&rec.sys, t));
+                    }
+                    if changed {
+                        check!(rec.sys.accept(t).map_err(analysis));
                         rec.sys.gather(rec.y);
                         check!(stepper.reset(&mut rec.sys, t, rec.y, None).map_err(ode));
                     }
@@ -384,6 +401,16 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 }
             }
             Err(e) => {
+                // After a recovery at this time, the step size that underflows on the
+                // retry is a symptom: report the kinematic failure that started it.
+                let e = match (e, pending.take()) {
+                    (OdeError::StepSizeTooSmall { t, .. }, Some(k))
+                        if k.t().is_some_and(|tk| t - tk <= STALL * span) =>
+                    {
+                        k
+                    }
+                    (e, _) => e,
+                };
                 let constraints = std::mem::take(&mut rec.sys.failure_constraints);
                 if form != Formulation::Partitioning || !recoverable(&e) {
                     bail!(SimErrorKind::from_ode(e, constraints));
@@ -406,10 +433,16 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                     bail!(SimErrorKind::from_ode(e, constraints));
                 }
                 rec.sys.update_indices();
+                if rec.sys.rank_changed {
+                    bail!(rank_changed(&rec.sys, ta));
+                }
+                check!(rec.sys.accept(ta).map_err(analysis));
                 rec.sys.gather(rec.y);
                 let h = stepper.h_next().abs() / 8.0;
                 let h0 = (!stepper.is_fixed_step() && h.is_finite() && h > 0.0).then_some(h);
                 check!(stepper.reset(&mut rec.sys, ta, rec.y, h0).map_err(ode));
+                rec.sys.failure_constraints = constraints;
+                pending = Some(e);
             }
         }
     }
@@ -435,6 +468,28 @@ fn assembly_error(e: AssemblyError) -> SimErrorKind {
     match eval {
         Some(v @ EvalError::NonFinite { .. }) => SimErrorKind::from_eval(v.clone()),
         _ => SimErrorKind::Assembly(e),
+    }
+}
+
+/// The rank of $C_q$ changed at a re-partition (redundant constraints that stop being
+/// redundant, or new ones): the motion went through a singular configuration.
+fn rank_changed<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>, t: f64) -> SimErrorKind {
+    let info = sys.info;
+    let constraints = sys
+        .kin
+        .partition()
+        .map(|p| {
+            p.redundant_rows()
+                .iter()
+                .map(|&i| info.holonomic[i].name)
+                .collect()
+        })
+        .unwrap_or_default();
+    SimErrorKind::Singular {
+        t,
+        matrix: super::SingularMatrix::DependentPositions,
+        ratio: 0.0,
+        constraints,
     }
 }
 

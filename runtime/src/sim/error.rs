@@ -197,6 +197,18 @@ impl SimErrorKind {
                 residual,
                 constraints: violated,
             },
+            // A branch switch that a step at the underflow limit still produces is a
+            // failure of K1 to follow the motion.
+            Error::Kinematics(KinematicsError::BranchSwitch {
+                t,
+                iterations,
+                residual,
+            }) => Self::NewtonFailed {
+                t,
+                iterations,
+                residual,
+                constraints,
+            },
             Error::Kinematics(KinematicsError::SingularDependent { t, ratio, .. }) => {
                 Self::Singular {
                     t,

@@ -25,6 +25,16 @@ use crate::{Error, Info, Mechanism};
 /// Pivot ratio below which the projection matrix counts as singular.
 const SINGULAR_RATIO: f64 = 1e-14;
 
+/// Recoverable kinematic failures in a row (since the last accepted step) before a
+/// failure stops the integrator: with the integrators' cut of 4 per failure the step
+/// has then shrunk by $4^{10} \approx 10^6$, and the driver's re-partition is the
+/// better cure.
+const MAX_RETRIES: u32 = 10;
+
+/// Relative size of a Newton correction of the K1 guess that never counts as a branch
+/// switch (see [`MechSystem::rhs`]), for the evaluations that hardly move.
+const BRANCH_FLOOR: f64 = 1e-8;
+
 pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub mech: &'a M,
     pub info: &'static Info,
@@ -52,6 +62,29 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub factorizations: u64,
     /// Holonomic constraints not met when the last analysis failed.
     pub failure_constraints: Vec<&'static str>,
+    /// Constraints the augmented solve found redundant so far.
+    pub redundant: Vec<&'static str>,
+    /// Projection: the constraint rows projected on, the first `rows_h` holonomic
+    /// (all rows unless Algorithm P dropped redundant ones, see [`Self::fit_rows`]).
+    rows: Vec<usize>,
+    rows_h: usize,
+    /// Partitioning: the last accepted full state, its time and the sign of
+    /// $\det J_d$ there (the reference of the branch check).
+    q_acc: Vec<f64>,
+    qd_acc: Vec<f64>,
+    t_acc: f64,
+    sign_acc: f64,
+    /// Recoverable failures since the last accepted step.
+    retries: u32,
+    /// Whether `q_acc`, `qd_acc` hold an accepted state.
+    anchored: bool,
+    /// A re-partition found another rank of $C_q$ than the first partition.
+    pub rank_changed: bool,
+    /// Partitioning, the last K1: its guess, the largest move of a coordinate from the
+    /// base state to the guess, and the largest Newton correction of the guess.
+    guess: Vec<f64>,
+    moved: f64,
+    correction: f64,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for MechSystem<'_, M> {
@@ -100,7 +133,52 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             failure_constraints: Vec::new(),
+            redundant: Vec::new(),
+            rows: (0..m).collect(),
+            rows_h: mh,
+            q_acc: vec![0.0; n],
+            qd_acc: vec![0.0; n],
+            t_acc: 0.0,
+            sign_acc: 0.0,
+            retries: 0,
+            anchored: false,
+            rank_changed: false,
+            guess: vec![0.0; n],
+            moved: 0.0,
+            correction: 0.0,
         })
+    }
+
+    /// Fits the state dimension (partitioning) or the projected rows (projection) to
+    /// the partition of the assembly, which may have dropped redundant holonomic
+    /// constraints; returns the names of the dropped ones.
+    pub fn fit_rows(&mut self) -> Vec<&'static str> {
+        let Some(p) = self.kin.partition() else {
+            return Vec::new();
+        };
+        let info = self.info;
+        let (n, mh, nnh) = (info.nq(), info.nh(), info.nnh());
+        let names = p
+            .redundant_rows()
+            .iter()
+            .map(|&i| info.holonomic[i].name)
+            .collect();
+        let r = p.holonomic_rows().len();
+        match self.form {
+            Formulation::Partitioning => self.dim = (2 * (n - r) - nnh).max(1),
+            Formulation::Projection => {
+                self.rows.clear();
+                self.rows.extend_from_slice(p.holonomic_rows());
+                self.rows.extend(mh..mh + nnh);
+                self.rows_h = r;
+                if r != mh {
+                    self.lu_h = DenseLu::new(r, 1);
+                    self.lu_v = DenseLu::new(r + nnh, 1);
+                }
+            }
+            Formulation::Baumgarte { .. } => {}
+        }
+        names
     }
 
     /// Copies the index sets of the current partition (no allocation: the capacity is
@@ -111,6 +189,12 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .partition()
             .expect("partitioning keeps a partition");
         let (eta, ind) = (p.dependent_velocity(), p.independent());
+        if !self.coords.is_empty() && self.coords.len() != eta.len() + ind.len() {
+            // The rank of C_q changed (a redundant row became independent or the
+            // reverse): the state would change dimension. The driver reports it.
+            self.rank_changed = true;
+            return false;
+        }
         let same = self.coords.len() == eta.len() + ind.len()
             && self.coords[..eta.len()] == *eta
             && self.coords[eta.len()..] == *ind;
@@ -123,6 +207,27 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         self.gamma.clear();
         self.gamma.extend_from_slice(p.independent());
         true
+    }
+
+    /// Partitioning: takes the current full state (consistent, at `t`) as the last
+    /// accepted one: the reference of the branch check and the state an evaluation
+    /// that failed recoverably falls back to. Runs K2 for the sign of $\det J_d$ under
+    /// the current partition (so call it again after a re-partition).
+    pub fn accept(&mut self, t: f64) -> Result<(), Error> {
+        if self.form != Formulation::Partitioning {
+            return Ok(());
+        }
+        self.factorizations += 1;
+        self.kin
+            .velocity(self.mech, &mut self.ws, t, &self.q, &mut self.qd)?;
+        self.q_acc.copy_from_slice(&self.q);
+        self.qd_acc.copy_from_slice(&self.qd);
+        self.t_acc = t;
+        self.t_state = t;
+        self.sign_acc = self.kin.dependent_sign();
+        self.retries = 0;
+        self.anchored = true;
+        Ok(())
     }
 
     /// Writes the state vector of the current full state `q`, `qd` into `y`.
@@ -151,19 +256,39 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         match self.form {
             Formulation::Partitioning => {
                 let np = self.coords.len();
+                // The base of the guess is the last accepted state (once there is one):
+                // a state of the motion, so that the predictor errs by O(dt²) and the
+                // branch check of `rhs` can compare the correction with the move.
+                // Chaining from the last evaluation (a stage of a trial step, maybe a
+                // rejected one) gives errors of the order of the move itself.
+                if self.anchored {
+                    self.q.copy_from_slice(&self.q_acc);
+                    self.qd.copy_from_slice(&self.qd_acc);
+                    self.t_state = self.t_acc;
+                }
+                let mut moved = 0.0_f64;
                 for (k, &j) in self.coords.iter().enumerate() {
+                    moved = moved.max((y[k] - self.q[j]).abs());
                     self.q[j] = y[k];
                 }
-                // First-order predictor for the guess of β: the last evaluation's β
-                // moved along its velocity. Without it, fast mechanisms (Andrews) and
-                // long steps let Newton converge to another assembly branch.
+                // First-order predictor for the guess of β: the base's β moved along
+                // its velocity. Without it, fast mechanisms (Andrews) and long steps
+                // let Newton converge to another assembly branch.
                 let dt = t - self.t_state;
                 if let Some(p) = self.kin.partition() {
                     for &j in p.dependent() {
                         self.q[j] += self.qd[j] * dt;
+                        moved = moved.max((self.qd[j] * dt).abs());
                     }
                 }
+                self.guess.copy_from_slice(&self.q);
                 let r = self.kin.position(self.mech, &mut self.ws, t, &mut self.q);
+                self.correction = self.kin.partition().map_or(0.0, |p| {
+                    p.dependent()
+                        .iter()
+                        .fold(0.0_f64, |a, &j| a.max((self.q[j] - self.guess[j]).abs()))
+                });
+                self.moved = moved;
                 let iterations = self.kin.residual_history().len().saturating_sub(1) as u64;
                 self.newton_iterations += iterations;
                 self.factorizations += iterations;
@@ -236,6 +361,11 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             &mut self.qdd,
             &mut self.lambda,
         )?;
+        // Reported once, as first identified: which rows of a dependent set the
+        // pivoting names can change along the motion, the redundancy does not.
+        if self.redundant.is_empty() {
+            self.redundant.extend(self.dynamics.redundant_constraints());
+        }
         Ok(())
     }
 
@@ -298,7 +428,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     });
                 }
                 self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
-                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, mh, n);
+                let rows = &self.rows[..self.rows_h];
+                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
@@ -307,12 +438,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                         constraints: self.violated(bound),
                     });
                 }
-                self.mu[..mh].copy_from_slice(self.ws.constraints());
-                self.lu_h.solve_vec(&mut self.mu[..mh]);
-                for i in 0..mh {
+                for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                    *mu = self.ws.constraints()[i];
+                }
+                self.lu_h.solve_vec(&mut self.mu[..rows.len()]);
+                for (&i, mu) in rows.iter().zip(&self.mu) {
                     let row = &self.ws.jacobian[i * n..(i + 1) * n];
                     for (qj, a) in self.q.iter_mut().zip(row) {
-                        *qj -= a * self.mu[i];
+                        *qj -= a * mu;
                     }
                 }
                 iterations += 1;
@@ -323,7 +456,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         if m > 0 {
             self.velocity_terms(t).map_err(eval)?;
             self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
-            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, m, n);
+            let rows = &self.rows[..];
+            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, rows, n);
             self.factorizations += 1;
             if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                 return Err(SimErrorKind::Singular {
@@ -333,12 +467,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     constraints: Vec::new(),
                 });
             }
-            self.mu.copy_from_slice(&self.vel);
-            self.lu_v.solve_vec(&mut self.mu);
-            for i in 0..m {
+            for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                *mu = self.vel[i];
+            }
+            self.lu_v.solve_vec(&mut self.mu[..rows.len()]);
+            for (&i, mu) in rows.iter().zip(&self.mu) {
                 let row = &self.ws.jacobian[i * n..(i + 1) * n];
                 for (v, a) in self.qd.iter_mut().zip(row) {
-                    *v -= a * self.mu[i];
+                    *v -= a * mu;
                 }
             }
         }
@@ -357,6 +493,11 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
 
     fn rhs_inner(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
         self.reconstruct(t, y)?;
+        self.rhs_inner_full(t, dy)
+    }
+
+    /// $\dot y$ from the full state already reconstructed at `t`.
+    fn rhs_inner_full(&mut self, t: f64, dy: &mut [f64]) -> Result<(), Error> {
         self.accelerations(t)?;
         match self.form {
             Formulation::Partitioning => {
@@ -379,15 +520,15 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
     }
 }
 
-/// Writes $A A^\mathsf{T}$ of the first `rows` rows of the dense row-major `a`
-/// (`rows × n`) into `lu`, factors it and returns the pivot ratio.
-fn gram(lu: &mut DenseLu, a: &[f64], rows: usize, n: usize) -> f64 {
+/// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
+/// into `lu`, factors it and returns the pivot ratio.
+fn gram(lu: &mut DenseLu, a: &[f64], rows: &[usize], n: usize) -> f64 {
     {
         let mut g = lu.matrix_mut();
-        for i in 0..rows {
-            let ri = &a[i * n..(i + 1) * n];
-            for k in 0..=i {
-                let rk = &a[k * n..(k + 1) * n];
+        for (i, &ri) in rows.iter().enumerate() {
+            let ri = &a[ri * n..(ri + 1) * n];
+            for (k, &rk) in rows[..=i].iter().enumerate() {
+                let rk = &a[rk * n..(rk + 1) * n];
                 let v: f64 = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
                 g[(i, k)] = v;
                 g[(k, i)] = v;
@@ -402,7 +543,65 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
         self.dim
     }
 
+    /// Partitioning: a kinematic failure of K1 or K2 (Newton diverged, a singular
+    /// dependent block, or a jump to another solution branch) comes from a guess
+    /// extrapolated too far, so it is [recoverable](RhsError::recoverable).
+    ///
+    /// K1 has jumped branches when
+    /// - the sign of $\det J_d$ differs from the last accepted state's (the mirror
+    ///   assembly, see [`Kinematics::dependent_sign`]), or
+    /// - Newton corrected the guess by more than the largest move of a coordinate
+    ///   from the base state to the guess (plus [`BRANCH_FLOOR`]): along the motion
+    ///   the first-order predictor moves by $O(h)$ and errs by $O(h^2)$, so a larger
+    ///   correction means the step is outside the predictor's range, as when an angle
+    ///   lands on another turn ($\beta + 2\pi k$: same sign, same configuration, a
+    ///   discontinuous state).
+    ///
+    /// The integrator then retries a shorter step
+    /// from the last accepted state, which also becomes the base of the next guess.
+    /// After [`MAX_RETRIES`] such failures in a row the failure stops the integrator
+    /// and the driver re-partitions.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        self.rhs_inner(t, y, dy).map_err(RhsError::new)
+        if self.form != Formulation::Partitioning {
+            return self.rhs_inner(t, y, dy).map_err(RhsError::new);
+        }
+        let r = self.reconstruct(t, y).and_then(|()| {
+            let sign = self.kin.dependent_sign();
+            let floor = BRANCH_FLOOR * (1.0 + inf_norm(&self.q));
+            if (self.sign_acc != 0.0 && sign != self.sign_acc)
+                || self.correction > self.moved + floor
+            {
+                let history = self.kin.residual_history();
+                return Err(Error::Kinematics(KinematicsError::BranchSwitch {
+                    t,
+                    iterations: history.len().saturating_sub(1),
+                    residual: history.last().copied().unwrap_or(0.0),
+                }));
+            }
+            Ok(())
+        });
+        let r = r.and_then(|()| self.rhs_inner_full(t, dy));
+        match r {
+            Ok(()) => Ok(()),
+            Err(
+                e @ Error::Kinematics(
+                    KinematicsError::NewtonFailed { .. }
+                    | KinematicsError::BranchSwitch { .. }
+                    | KinematicsError::SingularDependent { .. }
+                    | KinematicsError::SingularVelocity { .. },
+                ),
+            ) => {
+                self.q.copy_from_slice(&self.q_acc);
+                self.qd.copy_from_slice(&self.qd_acc);
+                self.t_state = self.t_acc;
+                self.retries += 1;
+                if self.retries <= MAX_RETRIES {
+                    Err(RhsError::recoverable(e))
+                } else {
+                    Err(RhsError::new(e))
+                }
+            }
+            Err(e) => Err(RhsError::new(e)),
+        }
     }
 }

@@ -198,6 +198,12 @@ pub struct Run {
     pub stats: Stats,
     /// Constraint and energy monitors.
     pub monitors: Monitors,
+    /// Constraints found redundant, named once as first identified (by Algorithm P at
+    /// assembly, or else by the acceleration solve; which rows of a dependent set get
+    /// named depends on the pivoting). Their multipliers are the minimum-norm split,
+    /// their small inconsistencies from drift are solved in the least-squares sense
+    /// (see [`Dynamics`](crate::Dynamics)), and K1, K2 and the projection use the other rows.
+    pub redundant_constraints: Vec<&'static str>,
 }
 
 impl Run {

@@ -5,10 +5,12 @@
 //! benchmark-models.md (the pendulum's exact solution), or a closed form derived in the
 //! test.
 
+mod andrews;
 mod exact;
 mod faults;
 mod models;
 mod pendulum;
+mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;

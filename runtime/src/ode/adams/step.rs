@@ -13,7 +13,7 @@
 // Index loops mirror the 1-based loops of ode.f so the port can be checked line by line.
 #![allow(clippy::needless_range_loop)]
 
-use super::super::common::{eval, UROUND};
+use super::super::common::{eval, is_recoverable, RECOVER_FACTOR, UROUND};
 use super::super::error::OdeError;
 use super::super::system::OdeSystem;
 use super::Adams;
@@ -219,6 +219,24 @@ impl Adams {
         error
     }
 
+    /// Block 3 after a recoverable failure of the right-hand side in the `ifail`-th
+    /// attempt: undo the attempt, cut the step by [`RECOVER_FACTOR`] (no error
+    /// estimate to scale by) and, from the third failure, drop to order 1 as ode.f
+    /// does. Returns the failure when the step would underflow.
+    fn recover(&mut self, ifail: u32, e: OdeError) -> Result<OdeError, OdeError> {
+        self.stats.rejected += 1;
+        self.phase1 = false;
+        self.restore();
+        self.h *= RECOVER_FACTOR;
+        if ifail >= 3 {
+            self.k = 1;
+        }
+        if self.h.abs() < 4.0 * UROUND * self.x.abs() {
+            return Err(e);
+        }
+        Ok(e)
+    }
+
     /// `STEP`: attempts until one step is accepted. `wt`, `eps` and `h` are set by the
     /// caller.
     pub(super) fn sg_step<S: OdeSystem + ?Sized>(&mut self, sys: &mut S) -> Result<(), OdeError> {
@@ -244,6 +262,7 @@ impl Adams {
         self.c.sig[1] = 1.0;
         let saved = self.c;
         let mut ifail = 0;
+        let mut failure = None;
         let est = loop {
             if self.attempts >= self.opts.max_steps {
                 return Err(OdeError::MaxStepsExceeded {
@@ -256,7 +275,12 @@ impl Adams {
             self.predict();
             let (x, p, yp) = (self.x, &self.p, &mut self.yp);
             if let Err(e) = eval(sys, &mut self.stats, x, p, yp) {
-                return Err(self.abort(saved, e));
+                if !is_recoverable(&e) {
+                    return Err(self.abort(saved, e));
+                }
+                ifail += 1;
+                failure = Some(self.recover(ifail, e)?);
+                continue;
             }
             let est = self.estimate();
             if est.err <= self.eps {
@@ -275,10 +299,11 @@ impl Adams {
             self.h *= temp2;
             self.k = knew;
             if self.h.abs() < fouru * self.x.abs() {
-                return Err(OdeError::StepSizeTooSmall {
+                // A recoverable failure on the way down is the better report.
+                return Err(failure.unwrap_or(OdeError::StepSizeTooSmall {
                     t: self.x,
                     h: self.h,
-                });
+                }));
             }
         };
         // Block 4: correct into `y_new` (compensation term into `p`), evaluate, and
@@ -301,7 +326,13 @@ impl Adams {
         }
         let (x, y_new, yp) = (self.x, &self.y_new, &mut self.yp);
         if let Err(e) = eval(sys, &mut self.stats, x, y_new, yp) {
-            return Err(self.abort(saved, e));
+            if !is_recoverable(&e) {
+                return Err(self.abort(saved, e));
+            }
+            // The corrected state failed recoverably: reject the step and take the
+            // attempts again, shorter.
+            self.recover(ifail + 1, e)?;
+            return self.sg_step(sys);
         }
         self.kold = k;
         self.hold = h;
