@@ -67,6 +67,8 @@ pub enum AssemblyError {
 
 fn resolve(
     info: &'static crate::Info,
+    quantity: crate::Quantity,
+    t: f64,
     list: &[(&str, f64)],
     seen: &mut Vec<usize>,
 ) -> Result<Vec<(usize, f64)>, AssemblyError> {
@@ -87,8 +89,8 @@ fn resolve(
             seen.push(i);
             if !v.is_finite() {
                 return Err(EvalError::NonFinite {
-                    quantity: crate::Quantity::Coordinates,
-                    t: f64::NAN,
+                    quantity,
+                    t,
                     row: i,
                     col: None,
                     value: v,
@@ -115,8 +117,20 @@ impl Kinematics {
         let info = ws.info();
         check_state(info, t, q, Some(qd))?;
         let mut seen = Vec::new();
-        let pos = resolve(info, prescription.coordinates, &mut seen)?;
-        let vel = resolve(info, prescription.velocities, &mut seen)?;
+        let pos = resolve(
+            info,
+            crate::Quantity::Coordinates,
+            t,
+            prescription.coordinates,
+            &mut seen,
+        )?;
+        let vel = resolve(
+            info,
+            crate::Quantity::Velocities,
+            t,
+            prescription.velocities,
+            &mut seen,
+        )?;
         for &(i, v) in &pos {
             q[i] = v;
         }

@@ -36,6 +36,10 @@ const STALL: f64 = 1e-10;
 /// Pivot ratio below which constraints are reported as nearly dependent in a failure.
 const NEAR_SINGULAR: f64 = 1e-3;
 
+/// Most rows an [`Output::Every`] grid may ask for: a finer grid is a mistake (a unit
+/// error) whose rows would not fit in memory; [`Output::Steps`] records every step.
+const MAX_GRID_ROWS: f64 = (1_u64 << 26) as f64;
+
 /// The output times in $(t_0, t_\text{end}]$.
 fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErrorKind> {
     let bad = |value| SimErrorKind::InvalidTimes { t0, t_end, value };
@@ -46,10 +50,12 @@ fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErr
     match output {
         Output::Steps => Ok(Vec::new()),
         Output::Every(dt) => {
-            if !(dt.is_finite() && *dt > 0.0) {
+            let k_max = ((span / dt) * (1.0 + 1e-12)).floor();
+            if !(dt.is_finite() && *dt > 0.0 && k_max <= MAX_GRID_ROWS) {
                 return Err(bad(*dt));
             }
-            let k_max = ((span / dt) * (1.0 + 1e-12)).floor() as usize;
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let k_max = k_max as usize;
             Ok((1..=k_max)
                 .map(|k| (t0 + k as f64 * dt).min(t_end))
                 .collect())
@@ -300,6 +306,14 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Output::Times(_) | Output::Steps => span / 100.0,
         };
         h_max = spacing.min(span / 100.0);
+    }
+    if let Some(h) = sim.h_init.filter(|h| !(*h > 0.0)) {
+        // The run goes forward: a negative first step is a bad step size, not a
+        // backward integration.
+        return Err(rec.fail(
+            None,
+            SimErrorKind::Integrator(OdeError::InvalidStepSize { h }),
+        ));
     }
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),

@@ -83,7 +83,8 @@ impl fmt::Display for NonFiniteSource {
 /// Why a simulation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimErrorKind {
-    /// The time span or the output times are invalid.
+    /// The time span or the output times are invalid (including an `output_every`
+    /// spacing so fine that the grid would have more than 2^26 rows).
     #[error(
         "invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value}"
     )]

@@ -330,7 +330,8 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
         self
     }
 
-    /// Rows every `dt` from the start, by dense output; the end is always recorded.
+    /// Rows every `dt` from the start, by dense output; the end is always recorded. A
+    /// grid of more than 2^26 rows is rejected ([`SimErrorKind::InvalidTimes`]).
     #[must_use]
     pub fn output_every(mut self, dt: f64) -> Self {
         self.output = Output::Every(dt);

@@ -138,3 +138,88 @@ fn invalid_times_are_rejected() {
         );
     }
 }
+
+#[test]
+fn a_grid_too_fine_for_memory_is_an_invalid_times_error() {
+    // 1e12 rows (or usize::MAX for 1e-300) used to be reserved up front: an abort on a
+    // failed allocation or a capacity-overflow panic.
+    let model = pendulum::Model::default();
+    for dt in [1e-300, 1e-12] {
+        let err = Simulation::new(&model)
+            .output_every(dt)
+            .run(1.0)
+            .unwrap_err();
+        assert!(
+            matches!(err.kind, SimErrorKind::InvalidTimes { value, .. } if value == dt),
+            "{err}"
+        );
+    }
+    // A fine grid that fits is still accepted.
+    let run = Simulation::new(&model).output_every(1e-4).run(1.0).unwrap();
+    assert_eq!(run.trajectory.len(), 10_001);
+}
+
+#[test]
+fn a_non_positive_first_step_is_an_invalid_step_size() {
+    // A negative step used to be taken for a backward integration and reported as an
+    // end time behind the start.
+    let model = pendulum::Model::default();
+    for h in [-1e-3, 0.0, f64::NAN] {
+        let err = Simulation::new(&model)
+            .initial_step(h)
+            .run(1.0)
+            .unwrap_err();
+        assert!(
+            matches!(
+                err.kind,
+                SimErrorKind::Integrator(pfaff::ode::OdeError::InvalidStepSize { h: e })
+                    if e.to_bits() == h.to_bits()
+            ),
+            "{err}"
+        );
+        assert_eq!(err.partial.trajectory.len(), 1);
+    }
+}
+
+#[test]
+fn a_non_finite_prescription_names_its_quantity_and_time() {
+    // A NaN prescribed velocity used to be reported as a coordinate at t = NaN.
+    let model = pendulum::Model::default();
+    let err = Simulation::new(&model)
+        .start_time(0.25)
+        .prescribe_velocity("y", f64::NAN)
+        .run(1.0)
+        .unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::NonFinite {
+                t: 0.25,
+                source_of: NonFiniteSource::Model {
+                    quantity: Quantity::Velocities,
+                    row: 1,
+                    col: None
+                }
+            }
+        ),
+        "{err}"
+    );
+    let err = Simulation::new(&model)
+        .prescribe_coordinate("x", f64::INFINITY)
+        .run(1.0)
+        .unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::NonFinite {
+                t: 0.0,
+                source_of: NonFiniteSource::Model {
+                    quantity: Quantity::Coordinates,
+                    row: 0,
+                    col: None
+                }
+            }
+        ),
+        "{err}"
+    );
+}
