@@ -192,6 +192,9 @@ impl Kinematics {
         self.sign
     }
 
+    /// $\lVert C\rVert_\infty$ before each iteration of the last K1
+    /// ([`position`](Self::position)) and after the last one; empty when that call failed
+    /// before evaluating $C$.
     #[must_use]
     pub fn residual_history(&self) -> &[f64] {
         &self.history
@@ -292,6 +295,8 @@ impl Kinematics {
         q: &mut [f64],
     ) -> Result<NewtonStats, KinematicsError> {
         let info = ws.info();
+        // The history describes this call even when it fails before the first residual.
+        self.history.clear();
         check_state(info, t, q, None)?;
         self.ensure_partition(mech, ws, t, q)?;
         let n = info.nq();

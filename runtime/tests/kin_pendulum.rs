@@ -325,3 +325,25 @@ fn non_finite_inputs_and_outputs_are_reported() {
     let err: pfaff::Error = err.into();
     assert!(err.to_string().contains("rod"));
 }
+
+#[test]
+fn residual_history_describes_the_last_call_even_when_it_fails_early() {
+    // The history of a K1 rejected on a NaN input used to be the previous call's, and
+    // the simulation counted those iterations again as Newton iterations.
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    kin.repartition(&mech, &mut ws, 0.0, &[0.6, -0.8]).unwrap();
+    let mut q = [0.3, -0.9];
+    let stats = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap();
+    assert!(stats.iterations > 0);
+    assert_eq!(kin.residual_history().len(), stats.iterations + 1);
+    let mut q = [f64::NAN, -0.9];
+    let err = kin.position(&mech, &mut ws, 0.0, &mut q).unwrap_err();
+    assert!(matches!(err, KinematicsError::Eval(_)), "{err}");
+    assert!(
+        kin.residual_history().is_empty(),
+        "{:?}",
+        kin.residual_history()
+    );
+}
