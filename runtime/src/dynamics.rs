@@ -38,7 +38,8 @@ use crate::linalg::elimination::Elimination;
 use crate::linalg::inf_norm;
 use crate::linalg::sparse::SparseKkt;
 use crate::workspace::{
-    check_finite, check_len, check_state, scatter_row_major, EvalError, Quantity, Workspace,
+    check_finite, check_len, check_same_model, check_state, scatter_row_major, EvalError, Quantity,
+    Workspace,
 };
 use crate::{Info, Mechanism};
 
@@ -258,6 +259,7 @@ impl Dynamics {
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
         let (n, m) = (info.nq(), info.nh() + info.nnh());
+        check_same_model(info, ws.info())?;
         check_state(info, t, q, Some(qd))?;
         check_len(Quantity::Accelerations, qdd, n)?;
         check_len(Quantity::Multipliers, lambda, m)?;

@@ -23,7 +23,7 @@ use crate::partition::{
     compute_with, condition_with, Condition, Partition, PartitionError, PartitionParams,
     Preferences,
 };
-use crate::workspace::{check_state, EvalError, Workspace};
+use crate::workspace::{check_same_model, check_state, EvalError, Workspace};
 use crate::{Info, Mechanism};
 
 /// Tuning of the Newton iteration K1.
@@ -133,6 +133,7 @@ pub struct Kinematics {
     history: Vec<f64>,
     rhs: Vec<f64>,
     sign: f64,
+    info: &'static Info,
 }
 
 impl Kinematics {
@@ -150,6 +151,7 @@ impl Kinematics {
             history: Vec::with_capacity(params.newton.max_iterations + 1),
             rhs: vec![0.0; m],
             sign: 0.0,
+            info,
         }
     }
 
@@ -219,6 +221,7 @@ impl Kinematics {
         q: &[f64],
         prefs: Preferences<'_>,
     ) -> Result<&Partition, PartitionError> {
+        check_same_model(self.info, ws.info())?;
         let p = compute_with(
             &mut self.elim,
             mech,
@@ -256,6 +259,7 @@ impl Kinematics {
         t: f64,
         q: &[f64],
     ) -> Result<Condition, KinematicsError> {
+        check_same_model(self.info, ws.info())?;
         self.ensure_partition(mech, ws, t, q)?;
         let Self {
             elim, partition, ..
@@ -297,6 +301,7 @@ impl Kinematics {
         let info = ws.info();
         // The history describes this call even when it fails before the first residual.
         self.history.clear();
+        check_same_model(self.info, info)?;
         check_state(info, t, q, None)?;
         self.ensure_partition(mech, ws, t, q)?;
         let n = info.nq();
@@ -401,6 +406,7 @@ impl Kinematics {
         qd: &mut [f64],
     ) -> Result<(), KinematicsError> {
         let info = ws.info();
+        check_same_model(self.info, info)?;
         check_state(info, t, q, Some(qd))?;
         self.ensure_partition(mech, ws, t, q)?;
         let (n, mh) = (info.nq(), info.nh());

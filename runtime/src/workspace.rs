@@ -95,6 +95,14 @@ pub enum EvalError {
         /// The length the model requires.
         expected: usize,
     },
+    /// The model passed is not the one the workspace (or analysis) was made for.
+    #[error("the model passed (`{found}`) is not the one the workspace or analysis was made for (`{expected}`): different name, sizes or sparsity patterns")]
+    Model {
+        /// The model of the workspace.
+        expected: &'static str,
+        /// The model passed.
+        found: &'static str,
+    },
     /// A sparsity pattern of the model is malformed.
     #[error("pattern of the {quantity} of model `{model}`: entry #{entry} {reason}")]
     Pattern {
@@ -174,6 +182,28 @@ pub(crate) fn check_len(quantity: Quantity, x: &[f64], expected: usize) -> Resul
 }
 
 /// Checks the input time, coordinates and (optionally) velocities of an evaluation.
+/// `found` is the model described by `expected` (the same `Info`, or one with the same
+/// name and shapes): the buffers sized by one fit the functions of the other.
+pub(crate) fn check_same_model(expected: &Info, found: &Info) -> Result<(), EvalError> {
+    let (a, b) = (expected, found);
+    let same = std::ptr::eq(a, b)
+        || (a.name == b.name
+            && a.nq() == b.nq()
+            && a.nh() == b.nh()
+            && a.nnh() == b.nnh()
+            && a.mass_pattern.len() == b.mass_pattern.len()
+            && a.holonomic_pattern.len() == b.holonomic_pattern.len()
+            && a.nonholonomic_pattern.len() == b.nonholonomic_pattern.len());
+    if same {
+        Ok(())
+    } else {
+        Err(EvalError::Model {
+            expected: a.name,
+            found: b.name,
+        })
+    }
+}
+
 pub(crate) fn check_state(
     info: &Info,
     t: f64,
@@ -288,6 +318,24 @@ impl Workspace {
         self.info
     }
 
+    /// The model passed has the description this workspace was made for (same
+    /// `Info`, or one with the same name and shapes), so that its functions write
+    /// buffers of the sizes reserved here; `q` (and `qd`) have its length.
+    fn check_model<M: Mechanism + ?Sized>(
+        &self,
+        mech: &M,
+        q: &[f64],
+        qd: Option<&[f64]>,
+    ) -> Result<(), EvalError> {
+        let a = self.info;
+        check_same_model(a, mech.info())?;
+        check_len(Quantity::Coordinates, q, a.nq())?;
+        if let Some(qd) = qd {
+            check_len(Quantity::Velocities, qd, a.nq())?;
+        }
+        Ok(())
+    }
+
     /// Evaluates the pattern values of $C_q$ and $G$ and scatters them into the dense
     /// $J$ ([`Workspace::jacobian`]).
     pub fn eval_jacobian<M: Mechanism + ?Sized>(
@@ -296,6 +344,7 @@ impl Workspace {
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
         self.eval_jacobian_values(mech, t, q)?;
         let n = self.info.nq();
         let split = self.info.nh() * n;
@@ -312,6 +361,7 @@ impl Workspace {
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
         let info = self.info;
         if info.nh() > 0 {
             mech.holonomic_jacobian(t, q, &mut self.cq_values);
@@ -341,6 +391,7 @@ impl Workspace {
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
         if self.info.nh() > 0 {
             mech.holonomic(t, q, &mut self.c);
             check_finite(Quantity::Constraints, t, &self.c)?;
@@ -355,6 +406,7 @@ impl Workspace {
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
         let info = self.info;
         if info.nh() > 0 && info.time.holonomic {
             mech.holonomic_rate(t, q, &mut self.ct);
@@ -379,6 +431,7 @@ impl Workspace {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, Some(qd))?;
         let mh = self.info.nh();
         let (h, nh) = self.gamma.split_at_mut(mh);
         if mh > 0 {
@@ -415,6 +468,7 @@ impl Workspace {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, Some(qd))?;
         mech.mass_matrix(t, q, &mut self.mass_values);
         check_finite_pattern(
             Quantity::MassMatrix,

@@ -307,7 +307,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         };
         h_max = spacing.min(span / 100.0);
     }
-    if let Some(h) = sim.h_init.filter(|h| !(*h > 0.0)) {
+    if let Some(h) = sim.h_init.filter(|h| h.is_nan() || *h <= 0.0) {
         // The run goes forward: a negative first step is a bad step size, not a
         // backward integration.
         return Err(rec.fail(
