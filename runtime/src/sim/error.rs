@@ -86,7 +86,7 @@ pub enum SimErrorKind {
     /// The time span or the output times are invalid (including an `output_every`
     /// spacing so fine that the grid would have more than 2^26 rows).
     #[error(
-        "invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value}"
+        "invalid time span or output times: t0 = {t0}, t_end = {t_end}, offending value {value:e}"
     )]
     InvalidTimes {
         /// Start time.
