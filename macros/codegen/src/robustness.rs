@@ -182,6 +182,33 @@ fn user_errors_are_diagnostics() {
         ),
         (
             quote!(
+                mod m {
+                    const r#t: f64 = 1.0;
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        t * x
+                    }
+                }
+            ),
+            "`t` is reserved and cannot be declared",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    static r#x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                }
+            ),
+            "duplicate name `x`",
+        ),
+        (
+            quote!(
                 mod m {}
             ),
             "at least one coordinate",
