@@ -23,6 +23,8 @@ pub mod emit;
 pub mod measure;
 pub mod model;
 pub mod parse;
+#[cfg(test)]
+mod robustness;
 pub mod sched;
 pub mod sym;
 

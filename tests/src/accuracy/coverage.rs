@@ -332,3 +332,89 @@ fn v5_multipliers() {
         "{errors:?}: M {M:?}, Q {Q:?}, γ {gamma:?}, x {x:?}"
     );
 }
+
+/// Names that generated code also uses (a coordinate `applied`, the argument of
+/// `free_motion_residual`; a coordinate `t0` and a parameter `tmp_0`, both of the form of
+/// a temporary; a parameter `x_dot` beside a coordinate `x`) and expressions whose
+/// printed form depends on precedence (`-x.powi(2)`, `(-x).powi(3)`, `a / (b * c)`,
+/// `a - (b - c)`).
+#[pfaff::mechanism]
+pub mod names {
+    const x_dot: f64 = 0.7;
+    const tmp_0: f64 = 1.5;
+    static x: Coordinate = Coordinate {};
+    static applied: Coordinate = Coordinate {};
+    static t0: Coordinate = Coordinate {};
+
+    fn kinetic_energy() -> f64 {
+        0.5 * (2.0 * x.dot().powi(2) + applied.dot().powi(2) + 3.0 * t0.dot().powi(2))
+    }
+
+    fn potential_energy() -> f64 {
+        -x.powi(2) * (applied - (t0 - x)) + (-x).powi(3) - x_dot / (tmp_0 * (2.0 + t0.sin()))
+            + x * t0 / (applied.cos() + 2.0) / (tmp_0 - x)
+            - (x - applied) * (t0 - x_dot) * (x + t0).sin()
+    }
+
+    #[holonomic]
+    fn sphere() -> f64 {
+        x.powi(2) * applied + (applied - t0).powi(2) * t0.cos() - tmp_0 * (x - (t0 - applied))
+    }
+}
+
+fn reference_names(p: &names::Params) -> Reference {
+    let (x_dot, tmp_0) = (p.x_dot, p.tmp_0);
+    Reference::new(3, |_, _, v| {
+        0.5 * (2.0 * v[0].powi(2) + v[1].powi(2) + 3.0 * v[2].powi(2))
+    })
+    .potential(move |_, q| {
+        let (x, a, t0) = (q[0], q[1], q[2]);
+        -(x * x) * (a - (t0 - x)) - x * x * x - x_dot / (tmp_0 * (2.0 + t0.sin()))
+            + x * t0 / (a.cos() + 2.0) / (tmp_0 - x)
+            - (x - a) * (t0 - x_dot) * (x + t0).sin()
+    })
+    .holonomic(move |_, q| {
+        let (x, a, t0) = (q[0], q[1], q[2]);
+        x * x * a + (a - t0) * (a - t0) * t0.cos() - tmp_0 * (x - (t0 - a))
+    })
+}
+
+#[test]
+fn derivatives_names() {
+    sweep(
+        "names",
+        0x5eed_000e,
+        names::Model::default,
+        |m| reference_names(&m.params),
+        |rng| State {
+            t: rng.range(0.0, 1.0),
+            q: rng.vec(3, -1.0, 1.0),
+            qd: rng.vec(3, -2.0, 2.0),
+        },
+    );
+}
+
+/// The free-motion residual of `names` with no applied force is `−γ + C_q M⁻¹ Q`, from
+/// the model's own (checked) functions, whatever the coordinates are called.
+#[test]
+fn free_motion_names() {
+    let model = names::Model::default();
+    let (t, q, qd) = (0.3, [0.4, -0.2, 0.7], [0.5, -1.0, 0.3]);
+    let mut m = vec![f64::NAN; names::INFO.mass_pattern.len()];
+    model.mass_matrix(t, &q, &mut m);
+    let m = dense(names::INFO.mass_pattern, &m, 3, 3);
+    let mut f = [f64::NAN; 3];
+    model.forces(t, &q, &qd, &mut f);
+    let mut cq = vec![f64::NAN; names::INFO.holonomic_pattern.len()];
+    model.holonomic_jacobian(t, &q, &mut cq);
+    let cq = dense(names::INFO.holonomic_pattern, &cq, 1, 3);
+    let mut gamma = [f64::NAN; 1];
+    model.holonomic_gamma(t, &q, &qd, &mut gamma);
+    let expected = -gamma[0] + (0..3).map(|k| cq[k] * f[k] / m[k * 4]).sum::<f64>();
+    let mut w = [f64::NAN; 1];
+    assert!(model.free_motion_residual(t, &q, &qd, &[0.0; 3], &mut w));
+    assert!(
+        (w[0] - expected).abs() <= 1e-12 * (1.0 + expected.abs()),
+        "{w:?} vs {expected}"
+    );
+}

@@ -245,7 +245,7 @@ impl Printer<'_> {
                 Node::Powi(x, n) if *n < 0 => den.push(if *n == -1 {
                     self.expr(*x, POWER)
                 } else {
-                    format!("{}^{}", self.expr(*x, POWER + 1), -n)
+                    format!("{}^{}", self.expr(*x, POWER + 1), -i64::from(*n))
                 }),
                 Node::Powi(x, n) => num.push(format!("{}^{n}", self.expr(*x, POWER + 1))),
                 _ => num.push(self.expr(f, PRODUCT + 1)),

@@ -84,7 +84,7 @@ impl Printer<'_> {
                     (ts, prec)
                 }
             }
-            Node::Powi(x, n) if *n < 0 => {
+            Node::Powi(x, n) if *n < 0 && *n != i32::MIN => {
                 let d = self.power(*x, -n);
                 (quote!(1.0 / #d), Prec::Product)
             }
@@ -171,7 +171,7 @@ impl Printer<'_> {
                         coef *= f64::from_bits(*b);
                         continue;
                     }
-                    Node::Powi(x, n) if *n < 0 => {
+                    Node::Powi(x, n) if *n < 0 && *n != i32::MIN => {
                         den.push(self.power(*x, -n));
                         continue;
                     }

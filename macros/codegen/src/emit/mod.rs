@@ -23,7 +23,14 @@ struct ModelNames {
     coords: Vec<Ident>,
     velocities: Vec<Ident>,
     params: Vec<Ident>,
-    temp_prefix: &'static str,
+    temp_prefix: String,
+    /// The argument of `free_motion_residual` holding the applied forces.
+    applied: String,
+}
+
+/// `name` without the `r#` of a raw identifier, the text generated names are built on.
+fn plain(name: &Ident) -> String {
+    syn::ext::IdentExt::unraw(name).to_string()
 }
 
 impl ModelNames {
@@ -31,28 +38,42 @@ impl ModelNames {
         let declared: HashSet<String> = model
             .coords
             .iter()
-            .map(|c| c.name.to_string())
-            .chain(model.params.iter().map(|p| p.name.to_string()))
+            .map(|c| plain(&c.name))
+            .chain(model.params.iter().map(|p| plain(&p.name)))
             .collect();
         let velocities = model
             .coords
             .iter()
             .map(|c| {
-                let mut name = format!("{}_dot", c.name);
+                let mut name = format!("{}_dot", plain(&c.name));
                 while declared.contains(&name) {
                     name.push('_');
                 }
                 Ident::new(&name, Span::call_site())
             })
             .collect();
-        let clash = declared.iter().any(|n| {
-            n.len() > 1 && n.starts_with('t') && n[1..].bytes().all(|b| b.is_ascii_digit())
-        });
+        // Temporaries are `<prefix><k>`: the prefix must not make any declared name.
+        let mut temp_prefix = String::from("t");
+        while declared.iter().any(|n| {
+            n.strip_prefix(temp_prefix.as_str())
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+        }) {
+            temp_prefix = if temp_prefix == "t" {
+                String::from("tmp_")
+            } else {
+                format!("{temp_prefix}_")
+            };
+        }
+        let mut applied = String::from("applied");
+        while declared.contains(&applied) {
+            applied.push('_');
+        }
         ModelNames {
             coords: model.coords.iter().map(|c| c.name.clone()).collect(),
             velocities,
             params: model.params.iter().map(|p| p.name.clone()).collect(),
-            temp_prefix: if clash { "tmp_" } else { "t" },
+            temp_prefix,
+            applied,
         }
     }
 }
@@ -64,7 +85,7 @@ impl Names for ModelNames {
             Var::Q(i) => self.coords[i as usize].clone(),
             Var::Qd(i) => self.velocities[i as usize].clone(),
             Var::Param(i) => self.params[i as usize].clone(),
-            Var::Delta(i) => format_ident!("delta_{}", self.coords[i as usize]),
+            Var::Delta(i) => format_ident!("delta_{}", plain(&self.coords[i as usize])),
         }
     }
     fn temp(&self, k: usize) -> Ident {
@@ -202,25 +223,15 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
             .collect();
         quote!(&[#(#items),*])
     };
-    let coordinates = symbols(&mut model.coords.iter().map(|c| (c.name.to_string(), &c.docs)));
-    let holonomic = symbols(
-        &mut model
-            .holonomic
-            .iter()
-            .map(|c| (c.name.to_string(), &c.docs)),
-    );
-    let nonholonomic = symbols(
-        &mut model
-            .nonholonomic
-            .iter()
-            .map(|c| (c.name.to_string(), &c.docs)),
-    );
+    let coordinates = symbols(&mut model.coords.iter().map(|c| (plain(&c.name), &c.docs)));
+    let holonomic = symbols(&mut model.holonomic.iter().map(|c| (plain(&c.name), &c.docs)));
+    let nonholonomic = symbols(&mut model.nonholonomic.iter().map(|c| (plain(&c.name), &c.docs)));
     let parameters: Vec<TokenStream> = model
         .params
         .iter()
         .zip(&pdefaults)
         .map(|(p, v)| {
-            let (n, doc) = (p.name.to_string(), &p.docs);
+            let (n, doc) = (plain(&p.name), &p.docs);
             quote!(::pfaff::__private::Parameter { name: #n, doc: #doc, default: #v })
         })
         .collect();
@@ -438,6 +449,7 @@ fn free_motion(
     let m = fm.base.len();
     let mut roots = fm.base.clone();
     roots.extend(fm.coefficients.iter().map(|e| e.expr));
+    let applied_arg = Ident::new(&names.applied, Span::call_site());
     let (code, prog) = body(g, names, &roots, |k, ts| {
         if k < m {
             let k = Literal::usize_unsuffixed(k);
@@ -448,16 +460,16 @@ fn free_motion(
                 Literal::u32_unsuffixed(e.row),
                 Literal::u32_unsuffixed(e.col),
             );
-            quote!(out[#r] += #ts * applied[#c];)
+            quote!(out[#r] += #ts * #applied_arg[#c];)
         }
     });
     let t = arg(&prog, "t", |v| *v == Var::Time);
     let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
     let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
     let applied = if fm.coefficients.is_empty() {
-        format_ident!("_applied")
+        format_ident!("_{}", names.applied)
     } else {
-        format_ident!("applied")
+        applied_arg
     };
     fns.extend(quote! {
         fn free_motion_residual(

@@ -71,6 +71,8 @@ pub struct Translator<'a> {
     defs: Vec<Option<ExprId>>,
     locals: Vec<(String, ExprId)>,
     ctx: Context,
+    /// The definition being translated, if any.
+    current_def: Option<usize>,
 }
 
 const METHODS: &[&str] = &[
@@ -89,6 +91,7 @@ impl<'a> Translator<'a> {
             defs: vec![None; n],
             locals: Vec::new(),
             ctx: Context::Definition,
+            current_def: None,
         }
     }
 
@@ -96,8 +99,10 @@ impl<'a> Translator<'a> {
     pub fn definitions(&mut self) {
         for i in 0..self.model.definitions.len() {
             let block = &self.model.definitions[i].block;
+            self.current_def = Some(i);
             self.defs[i] = self.block(block, Context::Definition);
         }
+        self.current_def = None;
     }
 
     /// Translates a function body (`let` bindings and a final expression).
@@ -225,6 +230,21 @@ impl<'a> Translator<'a> {
     }
 
     fn expr(&mut self, e: &syn::Expr) -> Option<ExprId> {
+        let id = self.expr_inner(e)?;
+        // Literals are finite, so the first non-finite constant is made by folding here.
+        if let Some(v) = self.g.as_const(id) {
+            if !v.is_finite() {
+                self.cx.error_spanned_by(
+                    e,
+                    format!("this expression is constant and evaluates to {v}"),
+                );
+                return None;
+            }
+        }
+        Some(id)
+    }
+
+    fn expr_inner(&mut self, e: &syn::Expr) -> Option<ExprId> {
         match e {
             syn::Expr::Lit(l) => self.literal(&l.lit),
             syn::Expr::Paren(p) => self.expr(&p.expr),
@@ -254,6 +274,10 @@ impl<'a> Translator<'a> {
                     syn::BinOp::Add(_) => self.g.add(vec![lhs, rhs]),
                     syn::BinOp::Sub(_) => self.g.sub(lhs, rhs),
                     syn::BinOp::Mul(_) => self.g.mul(vec![lhs, rhs]),
+                    syn::BinOp::Div(_) if self.g.is_zero(rhs) => {
+                        self.cx.error_spanned_by(&b.right, "division by zero");
+                        return None;
+                    }
                     syn::BinOp::Div(_) => self.g.div(lhs, rhs),
                     op => {
                         self.cx.error_spanned_by(
@@ -290,6 +314,11 @@ impl<'a> Translator<'a> {
             }
         };
         match v {
+            Ok(v) if !v.is_finite() => {
+                self.cx
+                    .error_spanned_by(lit, "number out of range for `f64`");
+                None
+            }
             Ok(v) => Some(self.g.constant(v)),
             Err(e) => {
                 self.cx.syn_error(e);
@@ -582,7 +611,12 @@ impl<'a> Translator<'a> {
             return None;
         }
         let Some(id) = self.defs[k] else {
-            if self.ctx == Context::Definition {
+            if self.ctx == Context::Definition && self.current_def == Some(k) {
+                self.cx.error_spanned_by(
+                    ident,
+                    format!("definition `{s}` uses itself; definitions are not recursive"),
+                );
+            } else if self.ctx == Context::Definition {
                 self.cx.error_spanned_by(
                     ident,
                     format!("definition `{s}` is declared below; a definition may use only the definitions above it"),

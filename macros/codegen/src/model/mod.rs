@@ -91,7 +91,8 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
     };
     let mut seen: HashMap<String, syn::Ident> = HashMap::new();
     let mut declare = |name: &syn::Ident| {
-        let s = name.to_string();
+        // `r#t` is the identifier `t`: compare names without the raw prefix.
+        let s = syn::ext::IdentExt::unraw(name).to_string();
         if kw::RESERVED.contains(&s.as_str()) {
             cx.error_spanned_by(name, format!("`{s}` is reserved and cannot be declared"));
         } else if let std::collections::hash_map::Entry::Vacant(slot) = seen.entry(s.clone()) {

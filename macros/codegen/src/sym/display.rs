@@ -63,8 +63,10 @@ impl Printer<'_> {
                     mag
                 }
             }
-            Node::Powi(x, n) if *n < 0 => (format!("1 / {}", self.power(*x, -n)), PRODUCT),
-            Node::Powi(x, n) => (self.power(*x, *n), ATOM),
+            Node::Powi(x, n) if *n < 0 => {
+                (format!("1 / {}", self.power(*x, -i64::from(*n))), PRODUCT)
+            }
+            Node::Powi(x, n) => (self.power(*x, i64::from(*n)), ATOM),
             Node::Powf(x, y) => (
                 format!("{}^({})", wrap(self.expr(*x), ATOM), self.expr(*y).0),
                 ATOM,
@@ -77,7 +79,7 @@ impl Printer<'_> {
         }
     }
 
-    fn power(&self, x: ExprId, n: i32) -> String {
+    fn power(&self, x: ExprId, n: i64) -> String {
         let b = wrap(self.expr(x), ATOM);
         if n == 1 {
             b
@@ -106,7 +108,7 @@ impl Printer<'_> {
         for &f in factors {
             match self.g.node(f) {
                 Node::Const(b) => coef *= f64::from_bits(*b),
-                Node::Powi(x, n) if *n < 0 => den.push(self.power(*x, -n)),
+                Node::Powi(x, n) if *n < 0 => den.push(self.power(*x, -i64::from(*n))),
                 _ => num.push(self.expr(f)),
             }
         }

@@ -360,13 +360,14 @@ impl Graph {
             };
         }
         let mut coefficient = 1.0;
-        let mut powers: BTreeMap<ExprId, i32> = BTreeMap::new();
+        // Exponents are summed in `i64`: a sum of `i32` exponents can leave `i32`.
+        let mut powers: BTreeMap<ExprId, i64> = BTreeMap::new();
         let mut stack = factors;
         while let Some(f) = stack.pop() {
             match self.node(f).clone() {
                 Node::Const(b) => coefficient *= f64::from_bits(b),
                 Node::Mul(inner) => stack.extend(inner.iter().copied()),
-                Node::Powi(base, n) => *powers.entry(base).or_insert(0) += n,
+                Node::Powi(base, n) => *powers.entry(base).or_insert(0) += i64::from(n),
                 _ => *powers.entry(f).or_insert(0) += 1,
             }
         }
@@ -387,8 +388,24 @@ impl Graph {
         }
         let mut out = Vec::with_capacity(powers.len() + 1);
         for (base, n) in powers {
-            if n != 0 {
-                out.push(self.powi_node(base, n));
+            if let Ok(n) = i32::try_from(n) {
+                if n != 0 {
+                    out.push(self.powi_node(base, n));
+                }
+                continue;
+            }
+            // Beyond `i32`: `xⁿ = (x^MAX)^k · xʳ` with `n = k·MAX + r`, `|k| < 2³¹`.
+            let m = i64::from(i32::MAX);
+            let k = i32::try_from(n / m).expect("a product has fewer than 2^31 factors");
+            let r = i32::try_from(n % m).expect("|n mod MAX| < MAX");
+            let whole = self.powi_node(base, i32::MAX);
+            out.push(if k == 1 {
+                whole
+            } else {
+                self.intern(Node::Powi(whole, k))
+            });
+            if r != 0 {
+                out.push(self.powi_node(base, r));
             }
         }
         out.sort();

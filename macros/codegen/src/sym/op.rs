@@ -194,7 +194,14 @@ pub fn partials(g: &mut Graph, id: ExprId) -> Vec<(ExprId, ExprId)> {
         // d xⁿ = n xⁿ⁻¹
         Node::Powi(x, n) => {
             let c = g.constant(f64::from(n));
-            let p = g.powi(x, n - 1);
+            let p = match n.checked_sub(1) {
+                Some(m) => g.powi(x, m),
+                // `n = i32::MIN`: `x^(n−1) = xⁿ · x⁻¹`.
+                None => {
+                    let inv = g.powi(x, -1);
+                    g.mul(vec![id, inv])
+                }
+            };
             vec![(x, g.mul(vec![c, p]))]
         }
         // d xʸ = y xʸ⁻¹ dx + xʸ ln x dy

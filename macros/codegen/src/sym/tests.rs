@@ -295,3 +295,28 @@ fn building_is_deterministic() {
     };
     assert_eq!(build(), build());
 }
+
+#[test]
+fn integer_exponents_never_wrap() {
+    let mut g = Graph::new();
+    let x = g.var(Var::Q(0));
+    let at = |g: &Graph, e: ExprId, v: f64| eval(g, &[e], &|_| v)[0];
+    // x^MAX · x^MAX · x = x^(2³² − 1): 0 below 1, infinite above, −1 at −1.
+    let big = g.powi(x, i32::MAX);
+    let p = g.mul(vec![big, big, x]);
+    assert_eq!(at(&g, p, 0.5), 0.0);
+    assert_eq!(at(&g, p, 2.0), f64::INFINITY);
+    assert_eq!(at(&g, p, -1.0), -1.0);
+    // d²/dx² x^(−MAX) = MAX (MAX + 1) x^(−MAX − 2): through x^MIN, whose exponent has no
+    // `n − 1` in `i32`.
+    let e = g.powi(x, -i32::MAX);
+    let d1 = diff::differentiate(&mut g, e, Var::Q(0));
+    let d2 = diff::differentiate(&mut g, d1, Var::Q(0));
+    assert_eq!(at(&g, d1, 2.0), 0.0);
+    assert_eq!(at(&g, d2, 2.0), 0.0);
+    assert_eq!(at(&g, d2, 0.5), f64::INFINITY);
+    assert_eq!(
+        at(&g, d2, 1.0),
+        f64::from(i32::MAX) * (f64::from(i32::MAX) + 1.0)
+    );
+}

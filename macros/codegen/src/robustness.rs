@@ -1,0 +1,234 @@
+//! Expansion of unusual but valid input: it must never panic, and what it emits must
+//! mean what the user wrote.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+/// The expansion as a string, or the panic message.
+fn expand(src: TokenStream) -> Result<String, String> {
+    std::panic::catch_unwind(|| crate::expand(quote!(), src).to_string()).map_err(|e| {
+        e.downcast_ref::<String>()
+            .cloned()
+            .or_else(|| e.downcast_ref::<&str>().map(|s| (*s).to_owned()))
+            .unwrap_or_default()
+    })
+}
+
+/// The generated function `name` (its tokens up to the next `fn`).
+fn function<'a>(out: &'a str, name: &str) -> &'a str {
+    let start = out
+        .find(&format!("fn {name} "))
+        .unwrap_or_else(|| panic!("no `{name}` in {out}"));
+    let end = out[start + 3..]
+        .find("fn ")
+        .map_or(out.len(), |e| start + 3 + e);
+    &out[start..end]
+}
+
+#[test]
+fn raw_identifiers_name_coordinates_and_parameters() {
+    let out = expand(quote!(
+        mod m {
+            const r#fn: f64 = 2.0;
+            static r#type: Coordinate = Coordinate {};
+            fn kinetic_energy() -> f64 {
+                0.5 * r#fn * r#type.dot().powi(2)
+            }
+        }
+    ))
+    .expect("expansion does not panic");
+    assert!(!out.contains("compile_error"), "{out}");
+    assert!(out.contains("let type_dot = qd [0]"), "{out}");
+    assert!(out.contains("name : \"type\""), "{out}");
+    assert!(out.contains("name : \"fn\""), "{out}");
+}
+
+#[test]
+fn exponents_at_the_ends_of_i32() {
+    // d/dx x^(−MAX) = −MAX x^MIN: the reciprocal of x^MIN has no `i32` exponent, so
+    // it is printed as `x.powi(-2147483648)`, never `1.0 / x.powi(...)`.
+    let out = expand(quote!(
+        mod m {
+            static x: Coordinate = Coordinate {};
+            fn kinetic_energy() -> f64 {
+                x.dot().powi(2)
+            }
+            fn potential_energy() -> f64 {
+                x.powi(2147483647) * x.powi(2147483647) * x
+            }
+            #[holonomic]
+            fn c() -> f64 {
+                x.powi(-2147483647)
+            }
+        }
+    ))
+    .expect("expansion does not panic");
+    assert!(!out.contains("compile_error"), "{out}");
+    let jac = function(&out, "holonomic_jacobian");
+    assert!(jac.contains("x . powi (- 2147483648)"), "{jac}");
+    assert!(!jac.contains("/"), "{jac}");
+    // V = x^(2^32 − 1), not the wrapped x^(−1).
+    let v = function(&out, "potential_energy");
+    assert!(!v.contains("/"), "{v}");
+    assert!(v.contains("2147483647"), "{v}");
+}
+
+#[test]
+fn user_errors_are_diagnostics() {
+    let cases = [
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        1e400 * x.dot().powi(2)
+                    }
+                }
+            ),
+            "number out of range for `f64`",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        x / (x - x)
+                    }
+                }
+            ),
+            "division by zero",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        x * (1.0 - 1.0).ln()
+                    }
+                }
+            ),
+            "this expression is constant and evaluates to -inf",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        (-1.0).sqrt() * x
+                    }
+                }
+            ),
+            "this expression is constant and evaluates to NaN",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn a() -> f64 {
+                        a()
+                    }
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2) * a()
+                    }
+                }
+            ),
+            "definition `a` uses itself; definitions are not recursive",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        x.powi(-2147483648)
+                    }
+                }
+            ),
+            "`powi` takes an integer literal exponent",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    static y: Coordinate = Coordinate {};
+                    fn mass_matrix() -> [[f64; 2]; 2] {
+                        [[1.0], [0.0, 1.0]]
+                    }
+                }
+            ),
+            "it must be 2×2",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn mass_matrix() -> [[f64; 1]; 1] {
+                        []
+                    }
+                }
+            ),
+            "it must be 1×1",
+        ),
+        (
+            quote!(
+                mod m {
+                    const r#t: f64 = 1.0;
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        t * x
+                    }
+                }
+            ),
+            "`t` is reserved and cannot be declared",
+        ),
+        (
+            quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    static r#x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        x.dot().powi(2)
+                    }
+                }
+            ),
+            "duplicate name `x`",
+        ),
+        (
+            quote!(
+                mod m {}
+            ),
+            "at least one coordinate",
+        ),
+        (
+            quote!(
+                mod m {
+                    fn a() -> f64 {
+                        1.0
+                    }
+                }
+            ),
+            "at least one coordinate",
+        ),
+    ];
+    for (src, msg) in cases {
+        let out = expand(src.clone()).unwrap_or_else(|p| panic!("panic {p} on {src}"));
+        assert!(
+            out.contains("compile_error") && out.contains(msg),
+            "{msg}: {out}"
+        );
+    }
+}
