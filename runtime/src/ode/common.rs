@@ -183,6 +183,41 @@ pub(crate) fn check_in_step(t: f64, t0: f64, t1: f64) -> Result<(), OdeError> {
     }
 }
 
+/// The argument checks of `interpolate`: `out` as long as `y`, `t` in the step
+/// `[t_prev, t_cur]`. Before the first step (`fresh`) the only value is `y`: it is
+/// written to `out` and `Ok(true)` returned.
+#[inline]
+pub(crate) fn interpolate_prelude(
+    t: f64,
+    (t_prev, t_cur): (f64, f64),
+    y: &[f64],
+    fresh: bool,
+    out: &mut [f64],
+) -> Result<bool, OdeError> {
+    check_len(y.len(), out.len())?;
+    check_in_step(t, t_prev, t_cur)?;
+    if fresh {
+        out.copy_from_slice(y);
+    }
+    Ok(fresh)
+}
+
+/// The common part of `set_state`: checks `new` (length, finite at `t`), copies it
+/// into `y` and counts the update. On error `y` is left unchanged.
+#[inline]
+pub(crate) fn replace_state(
+    t: f64,
+    y: &mut [f64],
+    new: &[f64],
+    stats: &mut OdeStats,
+) -> Result<(), OdeError> {
+    check_len(y.len(), new.len())?;
+    check_state(t, new)?;
+    y.copy_from_slice(new);
+    stats.state_updates += 1;
+    Ok(())
+}
+
 /// The step-size controller of Hairer's `dopri5.f` and `dop853.f`: an integral
 /// controller with Lund stabilization (a PI controller),
 /// $$h_{\text{new}} = h\Big/\operatorname{clamp}\!\Big(\frac{\text{err}^{\alpha}}

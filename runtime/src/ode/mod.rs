@@ -31,6 +31,7 @@ mod events;
 mod integrator;
 mod options;
 mod rk4;
+mod rk_driver;
 pub mod samples;
 mod system;
 

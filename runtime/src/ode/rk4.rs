@@ -18,7 +18,8 @@
 //! $b_2 = b_3 = \theta^2 - \frac23\theta^3$, $b_4 = -\frac12\theta^2 + \frac23\theta^3$.
 
 use super::common::{
-    check_in_step, check_len, check_state, check_stop, eval, is_recoverable, underflows,
+    check_len, check_state, check_stop, eval, interpolate_prelude, is_recoverable, replace_state,
+    underflows,
 };
 use super::error::OdeError;
 use super::integrator::Integrator;
@@ -201,10 +202,7 @@ impl Integrator for Rk4 {
     /// Third-order interpolant from the stage values; after [`set_state`](Self::set_state)
     /// it still describes the step as integrated (before the correction).
     fn interpolate(&self, t: f64, out: &mut [f64]) -> Result<(), OdeError> {
-        check_len(self.dim(), out.len())?;
-        check_in_step(t, self.t_prev, self.t)?;
-        if self.h_last == 0.0 {
-            out.copy_from_slice(&self.y);
+        if interpolate_prelude(t, (self.t_prev, self.t), &self.y, self.h_last == 0.0, out)? {
             return Ok(());
         }
         let th = (t - self.t_prev) / self.h_last;
@@ -222,11 +220,7 @@ impl Integrator for Rk4 {
 
     /// Replaces $y$; a one-step method keeps no other history.
     fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
-        check_len(self.dim(), y.len())?;
-        check_state(self.t, y)?;
-        self.y.copy_from_slice(y);
-        self.stats.state_updates += 1;
-        Ok(())
+        replace_state(self.t, &mut self.y, y, &mut self.stats)
     }
 
     fn stats(&self) -> &OdeStats {

@@ -47,7 +47,9 @@
 mod intrp;
 mod step;
 
-use super::common::{check_in_step, check_len, check_state, check_stop, eval, UROUND};
+use super::common::{
+    check_len, check_state, check_stop, eval, interpolate_prelude, replace_state, UROUND,
+};
 use super::error::OdeError;
 use super::integrator::Integrator;
 use super::options::{check_h0, OdeOptions, OdeStats};
@@ -348,10 +350,7 @@ impl Integrator for Adams {
     /// `INTRP`: the Adams polynomial of the last step through the current $(x, y)$,
     /// evaluated from the modified divided differences.
     fn interpolate(&self, t: f64, out: &mut [f64]) -> Result<(), OdeError> {
-        check_len(self.dim(), out.len())?;
-        check_in_step(t, self.xold, self.x)?;
-        if self.kold == 0 {
-            out.copy_from_slice(&self.y);
+        if interpolate_prelude(t, (self.xold, self.x), &self.y, self.kold == 0, out)? {
             return Ok(());
         }
         if !self.dense_ok {
@@ -368,13 +367,10 @@ impl Integrator for Adams {
     /// correction.
     fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
         let n = self.dim();
-        check_len(n, y.len())?;
-        check_state(self.x, y)?;
-        self.y.copy_from_slice(y);
+        replace_state(self.x, &mut self.y, y, &mut self.stats)?;
         if !self.nornd {
             self.phi[14 * n..15 * n].fill(0.0);
         }
-        self.stats.state_updates += 1;
         Ok(())
     }
 
