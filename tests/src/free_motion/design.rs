@@ -3,9 +3,7 @@
 //! report when the components cannot do it), and the member of a family of constraints
 //! that makes it free.
 
-use std::cell::RefCell;
-
-use pfaff::free_motion::{ForceDesign, Forced, ParameterSearch, Sample};
+use pfaff::free_motion::{ForceDesign, ParameterSearch, Sample};
 use pfaff::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, Mechanism,
     MechanismExt, Workspace,
@@ -14,7 +12,7 @@ use pfaff_models::{seed2_example1 as ex1, seed2_example2 as ex2};
 
 use super::models::{plane_family, v5};
 use super::sim::simulate;
-use super::{inf_norm, Rng};
+use super::{designed, inf_norm, Rng};
 
 /// On V5 (two constraints, full inertia): both designs zero the residual, the
 /// minimum-norm one is the shorter, and they differ by a force in ker K that does not
@@ -129,27 +127,7 @@ fn unsolvable_component_is_reported() {
 /// forces are not the paper's), with the multiplier at zero and the constraint kept.
 #[test]
 fn minimum_norm_forces_simulated() {
-    let fm = RefCell::new((
-        FreeMotion::new(&ex1::INFO, FreeMotionParams::default()),
-        Workspace::new(&ex1::INFO).unwrap(),
-    ));
-    let designed = Forced::new(
-        ex1::Model::default(),
-        |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
-            let (fm, ws) = &mut *fm.borrow_mut();
-            let s = fm
-                .free_forces(
-                    &ex1::Model::default(),
-                    ws,
-                    t,
-                    q,
-                    qd,
-                    ForceDesign::MinimumNorm,
-                )
-                .unwrap();
-            out.copy_from_slice(&s.applied);
-        },
-    );
+    let designed = designed(ex1::Model::default(), ForceDesign::MinimumNorm, |_, _| {});
     let (mut q0, mut qd0) = ([0.0; 3], [0.0; 3]);
     designed.initial_state(&mut q0, &mut qd0);
     let run = simulate(&designed, true, 0.0, &q0, &qd0, 2.0, 1e-12);

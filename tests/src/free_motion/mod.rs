@@ -9,6 +9,11 @@
 //! Run `cargo test --release -p pfaff-tests free_motion -- --nocapture` to see the
 //! observed errors.
 
+use std::cell::RefCell;
+
+use pfaff::free_motion::{ForceDesign, ForceSolution, Forced};
+use pfaff::{FreeMotion, FreeMotionParams, Mechanism, Workspace};
+
 mod models;
 mod sim;
 
@@ -33,6 +38,31 @@ fn assert_close(what: &str, x: &[f64], expected: &[f64], tol: f64) -> f64 {
         );
     }
     worst
+}
+
+/// `model` with its applied forces replaced, at every state, by the forces the
+/// free-motion analysis designs ([`FreeMotion::free_forces`] with `design`); `inspect`
+/// sees each design with the state's velocities.
+fn designed<M: Mechanism + Clone>(
+    model: M,
+    design: ForceDesign<'static>,
+    inspect: impl Fn(&ForceSolution, &[f64]),
+) -> impl Mechanism {
+    let info = model.info();
+    let analysis = RefCell::new((
+        FreeMotion::new(info, FreeMotionParams::default()),
+        Workspace::new(info).unwrap(),
+    ));
+    let plain = model.clone();
+    Forced::new(
+        model,
+        move |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
+            let (fm, ws) = &mut *analysis.borrow_mut();
+            let s = fm.free_forces(&plain, ws, t, q, qd, design).unwrap();
+            inspect(&s, qd);
+            out.copy_from_slice(&s.applied);
+        },
+    )
 }
 
 fn inf_norm(x: &[f64]) -> f64 {

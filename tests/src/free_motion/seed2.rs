@@ -2,8 +2,6 @@
 //! examples without applied forces (V1, V3), and their free motions (V2, V4) both as
 //! modelled and with the forces the analysis designs, simulated with multipliers.
 
-use std::cell::RefCell;
-
 use pfaff::free_motion::{ForceDesign, Forced};
 use pfaff::{
     AppliedForces, FreeMotion, FreeMotionParams, FreeMotionPoint, Mechanism, MechanismExt,
@@ -12,7 +10,7 @@ use pfaff::{
 use pfaff_models::{seed2_example1 as ex1, seed2_example2 as ex2};
 
 use super::sim::{samples, simulate};
-use super::{assert_close, inf_norm};
+use super::{assert_close, designed, inf_norm};
 
 /// Solver tolerance of the simulations; math-spec: integrated results to 100 × that.
 const TOL: f64 = 1e-12;
@@ -87,27 +85,12 @@ fn v2_exact(t: f64) -> ([f64; 3], [f64; 3]) {
 /// multipliers, |λ| stays below 1e-10 and the motion follows q = (1+t, t − t²/2, t).
 #[test]
 fn v2_designed_forces_simulated() {
-    let fm = RefCell::new((
-        FreeMotion::new(&ex1::INFO, FreeMotionParams::default()),
-        Workspace::new(&ex1::INFO).unwrap(),
-    ));
-    let designed = Forced::new(
+    let designed = designed(
         ex1::Model::default(),
-        |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
-            let (fm, ws) = &mut *fm.borrow_mut();
-            let s = fm
-                .free_forces(
-                    &ex1::Model::default(),
-                    ws,
-                    t,
-                    q,
-                    qd,
-                    ForceDesign::Components(&[1]),
-                )
-                .unwrap();
+        ForceDesign::Components(&[1]),
+        |s, qd| {
             assert!(s.exact);
             assert!((s.applied[1] + qd[0]).abs() <= 1e-15 * (1.0 + qd[0].abs()));
-            out.copy_from_slice(&s.applied);
         },
     );
     let (q0, qd0) = v2_exact(0.0);
@@ -225,26 +208,10 @@ fn v2_v4_free_without_multipliers() {
 /// V4 force; simulated with multipliers, λ stays at zero and the table is met.
 #[test]
 fn v4_designed_forces_simulated() {
-    let fm = RefCell::new((
-        FreeMotion::new(&ex2::INFO, FreeMotionParams::default()),
-        Workspace::new(&ex2::INFO).unwrap(),
-    ));
-    let designed = Forced::new(
+    let designed = designed(
         ex2::Model::default(),
-        |t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| {
-            let (fm, ws) = &mut *fm.borrow_mut();
-            let s = fm
-                .free_forces(
-                    &ex2::Model::default(),
-                    ws,
-                    t,
-                    q,
-                    qd,
-                    ForceDesign::Components(&[1]),
-                )
-                .unwrap();
-            out.copy_from_slice(&s.applied);
-        },
+        ForceDesign::Components(&[1]),
+        |_, _| {},
     );
     let (mut q0, mut qd0) = ([0.0; 3], [0.0; 3]);
     designed.initial_state(&mut q0, &mut qd0);
