@@ -76,6 +76,7 @@
 //! # Ok::<(), pfaff::sim::SimError>(())
 //! ```
 
+mod chart;
 mod driver;
 mod error;
 mod precision;
