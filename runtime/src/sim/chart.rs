@@ -121,7 +121,10 @@ impl Chart {
     }
 
     /// Moves `q` along the anchor's normals onto $C_R(q, t) = 0$; returns the number of
-    /// updates. `rows` are the holonomic rows of the chart.
+    /// updates. `rows` are the holonomic rows of the chart. With `exact = Some(ε)` the
+    /// iteration runs until $\lVert C_R\rVert_\infty \le \varepsilon(1 +
+    /// \lVert q\rVert_\infty)$ (the states the driver keeps); otherwise it stops at the
+    /// integrator's tolerance as described in the module docs.
     pub fn correct<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -129,6 +132,7 @@ impl Chart {
         t: f64,
         q: &mut [f64],
         rows: &[usize],
+        exact: Option<f64>,
     ) -> Result<usize, ChartFailure> {
         let n = q.len();
         let distance = q
@@ -150,8 +154,12 @@ impl Chart {
                     residual,
                 });
             }
-            if iteration == 0 && residual <= floor {
-                return Ok(0);
+            let converged = match exact {
+                Some(eps) => residual <= eps * (1.0 + inf_norm(q)),
+                None => iteration == 0 && residual <= floor,
+            };
+            if converged {
+                return Ok(iteration);
             }
             if iteration == MAX_ITERATIONS {
                 return Err(ChartFailure::Newton {
@@ -190,7 +198,7 @@ impl Chart {
                     self.rate_per_distance = Some(measured / distance);
                 }
             }
-            if step <= floor || rate / (1.0 - rate) * weighted <= KAPPA {
+            if exact.is_none() && (step <= floor || rate / (1.0 - rate) * weighted <= KAPPA) {
                 return Ok(iteration + 1);
             }
             previous = Some(weighted);

@@ -76,6 +76,7 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     /// [`reconstruct`](Self::reconstruct)), so that the driver's reconstruction of an
     /// accepted state the integrator has just evaluated costs nothing.
     cached: Option<f64>,
+    cached_exact: bool,
     y_cached: Vec<f64>,
 }
 
@@ -125,6 +126,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             q_acc: vec![0.0; n],
             retries: 0,
             cached: None,
+            cached_exact: false,
             y_cached: vec![0.0; 2 * n],
         })
     }
@@ -194,25 +196,46 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
     }
 
     /// Fills the full `q`, `qd` from the state `y` at `t`: for partitioning, the point
-    /// of the manifold the current chart assigns to `y`.
+    /// of the manifold the current chart assigns to `y`, to the integrator's tolerance
+    /// (see [`Chart`]).
     pub fn reconstruct(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        self.reconstruct_with(t, y, None)
+    }
+
+    /// [`reconstruct`](Self::reconstruct) for a state the driver keeps (accepted or
+    /// output): for partitioning, the constraints then hold to the simulation's Newton
+    /// tolerance, positions and velocities.
+    pub fn reconstruct_exact(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        let eps = self.kin.params().newton.tolerance;
+        self.reconstruct_with(t, y, Some(eps))
+    }
+
+    fn reconstruct_with(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        exact: Option<f64>,
+    ) -> Result<(), SimErrorKind> {
         let n = self.q.len();
         if self.form != Formulation::Partitioning {
             self.q.copy_from_slice(&y[..n]);
             self.qd.copy_from_slice(&y[n..]);
             return Ok(());
         }
-        if self.cached == Some(t) && self.y_cached == y {
+        let cached = self.cached == Some(t) && self.y_cached == y;
+        if cached && (exact.is_none() || self.cached_exact) {
             return Ok(());
         }
         self.cached = None;
-        self.q.copy_from_slice(&y[..n]);
-        self.qd.copy_from_slice(&y[n..]);
+        if !cached {
+            self.q.copy_from_slice(&y[..n]);
+            self.qd.copy_from_slice(&y[n..]);
+        }
         if self.rows_h > 0 {
             let rows = &self.rows[..self.rows_h];
             match self
                 .chart
-                .correct(self.mech, &mut self.ws, t, &mut self.q, rows)
+                .correct(self.mech, &mut self.ws, t, &mut self.q, rows, exact)
             {
                 Ok(iterations) => self.newton_iterations += iterations as u64,
                 Err(ChartFailure::Eval(e)) => return Err(SimErrorKind::from_eval(e)),
@@ -250,6 +273,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         }
         self.project_velocities(t)?;
         self.cached = Some(t);
+        self.cached_exact = exact.is_some();
         self.y_cached.copy_from_slice(y);
         Ok(())
     }
