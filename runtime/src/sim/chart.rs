@@ -120,11 +120,9 @@ impl Chart {
         gram_factor(&mut self.gram, &self.normals, rows, q.len())
     }
 
-    /// Moves `q` along the anchor's normals onto $C_R(q, t) = 0$; returns the number of
-    /// updates. `rows` are the holonomic rows of the chart. With `exact = Some(ε)` the
-    /// iteration runs until $\lVert C_R\rVert_\infty \le \varepsilon(1 +
-    /// \lVert q\rVert_\infty)$ (the states the driver keeps); otherwise it stops at the
-    /// integrator's tolerance as described in the module docs.
+    /// Moves `q` along the anchor's normals onto $C_R(q, t) = 0$, to the integrator's
+    /// tolerance (see the module docs); returns the number of updates. `rows` are the
+    /// holonomic rows of the chart.
     pub fn correct<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -132,7 +130,6 @@ impl Chart {
         t: f64,
         q: &mut [f64],
         rows: &[usize],
-        exact: Option<f64>,
     ) -> Result<usize, ChartFailure> {
         let n = q.len();
         let distance = q
@@ -154,12 +151,8 @@ impl Chart {
                     residual,
                 });
             }
-            let converged = match exact {
-                Some(eps) => residual <= eps * (1.0 + inf_norm(q)),
-                None => iteration == 0 && residual <= floor,
-            };
-            if converged {
-                return Ok(iteration);
+            if iteration == 0 && residual <= floor {
+                return Ok(0);
             }
             if iteration == MAX_ITERATIONS {
                 return Err(ChartFailure::Newton {
@@ -173,20 +166,20 @@ impl Chart {
             self.gram.solve_vec(&mut self.mu);
             let mut step = 0.0_f64;
             let mut weighted = 0.0_f64;
-            for j in 0..n {
+            for (j, qj) in q.iter_mut().enumerate() {
                 let dq: f64 = -self
                     .mu
                     .iter()
                     .zip(rows)
                     .map(|(mu, &i)| self.normals[i * n + j] * mu)
                     .sum::<f64>();
-                q[j] += dq;
+                *qj += dq;
                 step = step.max(dq.abs());
-                weighted = weighted.max(dq.abs() / (self.atol + self.rtol * q[j].abs()));
+                weighted = weighted.max(dq.abs() / (self.atol + self.rtol * qj.abs()));
             }
             if let Some(p) = previous {
                 let measured = weighted / p;
-                if !(measured < DIVERGENCE) {
+                if measured.is_nan() || measured >= DIVERGENCE {
                     return Err(ChartFailure::Newton {
                         iterations: iteration + 1,
                         residual,
@@ -198,7 +191,7 @@ impl Chart {
                     self.rate_per_distance = Some(measured / distance);
                 }
             }
-            if exact.is_none() && (step <= floor || rate / (1.0 - rate) * weighted <= KAPPA) {
+            if step <= floor || rate / (1.0 - rate) * weighted <= KAPPA {
                 return Ok(iteration + 1);
             }
             previous = Some(weighted);

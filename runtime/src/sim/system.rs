@@ -76,7 +76,6 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     /// [`reconstruct`](Self::reconstruct)), so that the driver's reconstruction of an
     /// accepted state the integrator has just evaluated costs nothing.
     cached: Option<f64>,
-    cached_exact: bool,
     y_cached: Vec<f64>,
 }
 
@@ -126,7 +125,6 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             q_acc: vec![0.0; n],
             retries: 0,
             cached: None,
-            cached_exact: false,
             y_cached: vec![0.0; 2 * n],
         })
     }
@@ -176,7 +174,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .eval_jacobian(self.mech, t, &self.q)
             .map_err(SimErrorKind::from_eval)?;
         self.factorizations += 1;
-        let ratio = self.chart.anchor(&self.ws, &self.q, &self.rows[..self.rows_h]);
+        let ratio = self
+            .chart
+            .anchor(&self.ws, &self.q, &self.rows[..self.rows_h]);
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
                 t,
@@ -199,43 +199,23 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
     /// of the manifold the current chart assigns to `y`, to the integrator's tolerance
     /// (see [`Chart`]).
     pub fn reconstruct(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
-        self.reconstruct_with(t, y, None)
-    }
-
-    /// [`reconstruct`](Self::reconstruct) for a state the driver keeps (accepted or
-    /// output): for partitioning, the constraints then hold to the simulation's Newton
-    /// tolerance, positions and velocities.
-    pub fn reconstruct_exact(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
-        let eps = self.kin.params().newton.tolerance;
-        self.reconstruct_with(t, y, Some(eps))
-    }
-
-    fn reconstruct_with(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        exact: Option<f64>,
-    ) -> Result<(), SimErrorKind> {
         let n = self.q.len();
         if self.form != Formulation::Partitioning {
             self.q.copy_from_slice(&y[..n]);
             self.qd.copy_from_slice(&y[n..]);
             return Ok(());
         }
-        let cached = self.cached == Some(t) && self.y_cached == y;
-        if cached && (exact.is_none() || self.cached_exact) {
+        if self.cached == Some(t) && self.y_cached == y {
             return Ok(());
         }
         self.cached = None;
-        if !cached {
-            self.q.copy_from_slice(&y[..n]);
-            self.qd.copy_from_slice(&y[n..]);
-        }
+        self.q.copy_from_slice(&y[..n]);
+        self.qd.copy_from_slice(&y[n..]);
         if self.rows_h > 0 {
             let rows = &self.rows[..self.rows_h];
             match self
                 .chart
-                .correct(self.mech, &mut self.ws, t, &mut self.q, rows, exact)
+                .correct(self.mech, &mut self.ws, t, &mut self.q, rows)
             {
                 Ok(iterations) => self.newton_iterations += iterations as u64,
                 Err(ChartFailure::Eval(e)) => return Err(SimErrorKind::from_eval(e)),
@@ -256,9 +236,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             // A correction larger than the move from the last accepted state: Newton
             // went to another intersection of the normal space with the manifold.
             let (mut moved, mut correction) = (0.0_f64, 0.0_f64);
-            for j in 0..n {
-                moved = moved.max((y[j] - self.q_acc[j]).abs());
-                correction = correction.max((self.q[j] - y[j]).abs());
+            for ((&yj, &qj), &aj) in y.iter().zip(&self.q).zip(&self.q_acc) {
+                moved = moved.max((yj - aj).abs());
+                correction = correction.max((qj - yj).abs());
             }
             let scale = inf_norm(&self.q);
             let floor = BRANCH_FLOOR * (1.0 + scale) + self.chart.tolerance(scale);
@@ -273,9 +253,26 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         }
         self.project_velocities(t)?;
         self.cached = Some(t);
-        self.cached_exact = exact.is_some();
         self.y_cached.copy_from_slice(y);
         Ok(())
+    }
+
+    /// [`reconstruct`](Self::reconstruct) for a state the driver keeps (accepted or
+    /// output): for partitioning, the point of the chart (when the integrator has just
+    /// evaluated there, otherwise `y`) polished by [`project`](Self::project), so that
+    /// the constraints hold to the simulation's Newton tolerance (the polish is below
+    /// the integrator's tolerance, the derivatives the integrator keeps stay valid).
+    pub fn reconstruct_exact(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        if self.form != Formulation::Partitioning {
+            return self.reconstruct(t, y);
+        }
+        if self.cached != Some(t) || self.y_cached != y {
+            let n = self.q.len();
+            self.q.copy_from_slice(&y[..n]);
+            self.qd.copy_from_slice(&y[n..]);
+        }
+        self.cached = None;
+        self.project(t)
     }
 
     /// $\ddot q$ and $\lambda$ at the full state (with the stabilization term for
@@ -446,7 +443,6 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .map(|(_, s)| s.name)
             .collect()
     }
-
 }
 
 impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
@@ -463,9 +459,7 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
     /// the failure ends the run.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.q.len();
-        let r = self
-            .reconstruct(t, y)
-            .and_then(|()| self.accelerations(t));
+        let r = self.reconstruct(t, y).and_then(|()| self.accelerations(t));
         match r {
             Ok(()) => {
                 dy[..n].copy_from_slice(&self.qd);
