@@ -302,16 +302,6 @@ impl<'a> Translator<'a> {
                 return None;
             }
         };
-        // Literals are finite, so the first non-finite constant is made by folding here.
-        if let Some(v) = self.g.as_const(id) {
-            if !v.is_finite() {
-                self.cx.error_spanned_by(
-                    e,
-                    format!("this expression is constant and evaluates to {v}"),
-                );
-                return None;
-            }
-        }
         Some(id)
     }
 

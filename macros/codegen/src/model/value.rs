@@ -295,8 +295,25 @@ const MATRIX_FUNCTIONS: &[&str] = &[
 ];
 
 impl Translator<'_> {
-    /// Translates `e` to a value of any kind.
+    /// Translates `e` to a value of any kind. A constant that folds to a non-finite
+    /// value is an error at the smallest expression that makes it.
     pub fn value(&mut self, e: &syn::Expr) -> Option<Value> {
+        let v = self.value_inner(e)?;
+        if let Value::Scalar(id) = v {
+            if let Some(c) = self.g.as_const(id) {
+                if !c.is_finite() {
+                    self.cx.error_spanned_by(
+                        e,
+                        format!("this expression is constant and evaluates to {c}"),
+                    );
+                    return None;
+                }
+            }
+        }
+        Some(v)
+    }
+
+    fn value_inner(&mut self, e: &syn::Expr) -> Option<Value> {
         match e {
             syn::Expr::Paren(p) => self.value(&p.expr),
             syn::Expr::Group(p) => self.value(&p.expr),
