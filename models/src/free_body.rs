@@ -26,9 +26,9 @@ pub mod free_body {
     /// Euler parameter θ0.
     static e0: Coordinate = Coordinate { q0: 1.0 };
     /// Euler parameter θ1.
-    static e1: Coordinate = Coordinate {};
+    static e1: Coordinate = Coordinate { qd0: 0.5 };
     /// Euler parameter θ2.
-    static e2: Coordinate = Coordinate { qd0: 0.5 };
+    static e2: Coordinate = Coordinate {};
     /// Euler parameter θ3.
     static e3: Coordinate = Coordinate { qd0: 1.0 };
 
