@@ -478,6 +478,7 @@ impl Chain {
             time: TimeDependence::default(),
             nonholonomic_homogeneous: true,
             conservative: true,
+            ..Info::EMPTY
         }));
         Self {
             n,
