@@ -107,3 +107,40 @@ fn free_body_keeps_energy_and_angular_momentum_v12() {
     assert!(worst_norm < 1e-10, "normalization error {worst_norm:e}");
     assert!(worst_w < 1e-7, "angular velocity error {worst_w:e}");
 }
+
+/// `sleigh_bodies` (a body on a `KnifeEdge`) generates the hand-written sleigh's
+/// equations: the same `M`, `G` and `γ_nh` at random states, and the same motion.
+#[test]
+fn sleigh_from_a_knife_edge_equals_the_hand_written_model() {
+    use pfaff_models::{sleigh, sleigh_bodies};
+    let (hand, bodies) = (sleigh::Model::default(), sleigh_bodies::Model::default());
+    for k in 0..10 {
+        let s = f64::from(k);
+        let q = [0.3 * s.sin(), 0.2 * s.cos(), 0.7 * s];
+        let qd = [s.cos(), 0.5 - 0.1 * s, 0.4 * s.sin()];
+        let (mut g1, mut g2) = ([0.0; 3], [0.0; 3]);
+        hand.nonholonomic_matrix_dense_inplace(0.0, &q, &mut g1);
+        bodies.nonholonomic_matrix_dense_inplace(0.0, &q, &mut g2);
+        assert!(max_diff(&g1, &g2) < 1e-15, "{g1:?} {g2:?}");
+        let (mut c1, mut c2) = ([0.0; 1], [0.0; 1]);
+        hand.nonholonomic_gamma(0.0, &q, &qd, &mut c1);
+        bodies.nonholonomic_gamma(0.0, &q, &qd, &mut c2);
+        assert!(max_diff(&c1, &c2) < 1e-15);
+        let (mut m1, mut m2) = ([0.0; 9], [0.0; 9]);
+        hand.mass_matrix_dense_inplace(0.0, &q, &mut m1);
+        bodies.mass_matrix_dense_inplace(0.0, &q, &mut m2);
+        assert!(max_diff(&m1, &m2) < 1e-15);
+    }
+    let run = |m: &dyn Mechanism| {
+        Simulation::new(m)
+            .integrator(Method::Dop853)
+            .tolerances(1e-11, 1e-13)
+            .output_every(0.5)
+            .run(5.0)
+            .expect("the sleigh runs")
+    };
+    let (a, b) = (run(&hand), run(&bodies));
+    let (_, qa, _) = a.final_state().expect("a final state");
+    let (_, qb, _) = b.final_state().expect("a final state");
+    assert!(max_diff(qa, qb) < 1e-10, "{qa:?} {qb:?}");
+}

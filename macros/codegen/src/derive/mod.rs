@@ -130,6 +130,14 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     } else {
         match bodies::expand(cx, &mut tr, &model.decls, &param_defaults) {
             Some(b) => Some(b),
+            // With every frame defined, the outputs can still be translated, so that
+            // their errors are reported with the body level's.
+            None if tr.frames.len() == model.frame_names().len() => {
+                for f in &model.outputs {
+                    tr.block(&f.block, Context::Output);
+                }
+                return None;
+            }
             None => return None,
         }
     };
