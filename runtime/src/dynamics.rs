@@ -266,6 +266,21 @@ impl Dynamics {
         ws.eval_mass_and_forces(mech, t, q, qd)?;
         ws.eval_jacobian_values(mech, t, q)?;
         ws.eval_gamma(mech, t, q, qd)?;
+        self.solve_evaluated(ws, t, shift, qdd, lambda)
+    }
+
+    /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
+    /// $\gamma$ already evaluated in `ws` (lengths checked by the caller).
+    pub(crate) fn solve_evaluated(
+        &mut self,
+        ws: &mut Workspace,
+        t: f64,
+        shift: Option<&[f64]>,
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<AccelerationStats, DynamicsError> {
+        let info = self.info;
+        let (n, m) = (info.nq(), info.nh() + info.nnh());
         self.b[..n].copy_from_slice(&ws.forces);
         self.b[n..].copy_from_slice(&ws.gamma);
         if let Some(shift) = shift {

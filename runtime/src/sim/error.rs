@@ -253,9 +253,9 @@ impl SimErrorKind {
         }
     }
 
-    /// Classifies an integrator error, unwrapping the analyses' errors from the
-    /// right-hand side.
-    pub(crate) fn from_ode(e: OdeError, constraints: Vec<&'static str>) -> Self {
+    /// Classifies an integrator error (a failed evaluation's own kind is held by the
+    /// system that failed, see `System::take_failure`).
+    pub(crate) fn from_ode(e: OdeError) -> Self {
         match e {
             OdeError::StepSizeTooSmall { t, h } => Self::StepSizeTooSmall { t, h },
             OdeError::MaxStepsExceeded { t, steps } => Self::MaxSteps { t, steps },
@@ -269,19 +269,6 @@ impl SimErrorKind {
                     quantity,
                     component,
                 },
-            },
-            e @ OdeError::Rhs { .. } => match e.into_rhs_error::<Self>() {
-                Ok((_, mut kind)) => {
-                    if let Self::NewtonFailed { constraints: c, .. }
-                    | Self::Singular { constraints: c, .. } = &mut kind
-                    {
-                        if c.is_empty() {
-                            *c = constraints;
-                        }
-                    }
-                    kind
-                }
-                Err(other) => Self::Integrator(other),
             },
             other => Self::Integrator(other),
         }

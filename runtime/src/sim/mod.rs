@@ -88,6 +88,8 @@
 mod chart;
 mod driver;
 mod error;
+mod formulation;
+mod point;
 mod precision;
 mod stepper;
 mod system;
@@ -95,6 +97,7 @@ mod trajectory;
 
 pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
+pub use system::{Failed, StateSpace};
 pub use trajectory::{Monitors, Run, Stats, Trajectory};
 
 use crate::{DynamicsParams, KinematicsParams, Mechanism, NewtonParams, PartitionParams};
