@@ -23,8 +23,8 @@
 //! Invariant: no allocation after [`Chart::new`] (except when building an error).
 
 use super::point::Point;
-use crate::linalg::dense::{gram_factor, DenseLu};
 use crate::linalg::inf_norm;
+use crate::linalg::small::{gram_cholesky, SmallCholesky};
 use crate::workspace::EvalError;
 use crate::Mechanism;
 
@@ -73,7 +73,7 @@ pub(crate) struct Chart {
     /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows`.
     normals: Vec<f64>,
     /// $N N^\mathsf{T}$, factored.
-    gram: DenseLu,
+    gram: SmallCholesky,
     /// Normal coordinates of the current update.
     mu: Vec<f64>,
     /// Measured contraction rate per unit distance from the anchor.
@@ -89,7 +89,7 @@ impl Chart {
         Self {
             anchor: vec![0.0; n],
             normals: vec![0.0; m * n],
-            gram: DenseLu::new(r, 1),
+            gram: SmallCholesky::new(r),
             mu: vec![0.0; r],
             rate_per_distance: None,
             rtol,
@@ -113,11 +113,11 @@ impl Chart {
         self.anchor.copy_from_slice(&p.q);
         if self.mu.len() != p.rows_h {
             // Assembly dropped redundant rows (allocates, once).
-            self.gram = DenseLu::new(p.rows_h, 1);
+            self.gram = SmallCholesky::new(p.rows_h);
             self.mu = vec![0.0; p.rows_h];
         }
         let n = p.q.len();
-        Ok(gram_factor(
+        Ok(gram_cholesky(
             &mut self.gram,
             &self.normals,
             &p.rows[..p.rows_h],
@@ -166,7 +166,7 @@ impl Chart {
             for (mu, &i) in self.mu.iter_mut().zip(rows) {
                 *mu = c[i];
             }
-            self.gram.solve_vec(&mut self.mu);
+            self.gram.solve(&mut self.mu);
             let mut step = 0.0_f64;
             let mut weighted = 0.0_f64;
             for (j, qj) in p.q.iter_mut().enumerate() {

@@ -14,8 +14,8 @@
 
 use super::error::{SimErrorKind, SingularMatrix};
 use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
-use crate::linalg::dense::{gram_factor, DenseLu};
 use crate::linalg::inf_norm;
+use crate::linalg::small::{gram_cholesky, SmallCholesky};
 use crate::workspace::{EvalError, Workspace};
 use crate::{Error, Info, Mechanism, NewtonParams};
 
@@ -84,8 +84,8 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// $[C_q\dot q + C_t;\ G\dot q + g]$.
     vel: Vec<f64>,
     mu: Vec<f64>,
-    lu_h: DenseLu,
-    lu_v: DenseLu,
+    lu_h: SmallCholesky,
+    lu_v: SmallCholesky,
     /// The constraint rows projected on, the first `rows_h` holonomic (all rows unless
     /// assembly dropped redundant ones, see [`Point::fit_rows`]).
     pub rows: Vec<usize>,
@@ -122,8 +122,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             lambda: vec![0.0; m],
             vel: vec![0.0; m],
             mu: vec![0.0; m],
-            lu_h: DenseLu::new(mh, 1),
-            lu_v: DenseLu::new(m, 1),
+            lu_h: SmallCholesky::new(mh),
+            lu_v: SmallCholesky::new(m),
             rows: (0..m).collect(),
             rows_h: mh,
             constraints: Stamp::new(n, false),
@@ -163,8 +163,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.rows.extend(mh..mh + nnh);
         self.rows_h = holonomic.len();
         if self.rows_h != mh {
-            self.lu_h = DenseLu::new(self.rows_h, 1);
-            self.lu_v = DenseLu::new(self.rows.len(), 1);
+            self.lu_h = SmallCholesky::new(self.rows_h);
+            self.lu_v = SmallCholesky::new(self.rows.len());
         }
     }
 
@@ -305,7 +305,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 }
                 self.dense_jacobian(t).map_err(eval)?;
                 let rows = &self.rows[..self.rows_h];
-                let ratio = gram_factor(&mut self.lu_h, self.ws.jacobian(), rows, n);
+                let ratio = gram_cholesky(&mut self.lu_h, self.ws.jacobian(), rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
@@ -317,7 +317,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 for (mu, &i) in self.mu.iter_mut().zip(rows) {
                     *mu = self.ws.constraints()[i];
                 }
-                self.lu_h.solve_vec(&mut self.mu[..rows.len()]);
+                self.lu_h.solve(&mut self.mu[..rows.len()]);
                 let jac = self.ws.jacobian();
                 for (&i, mu) in rows.iter().zip(&self.mu) {
                     for (qj, a) in self.q.iter_mut().zip(&jac[i * n..(i + 1) * n]) {
@@ -345,7 +345,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.velocity_residuals(t).map_err(eval)?;
         self.dense_jacobian(t).map_err(eval)?;
         let rows = &self.rows[..];
-        let ratio = gram_factor(&mut self.lu_v, self.ws.jacobian(), rows, n);
+        let ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), rows, n);
         self.factorizations += 1;
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
@@ -358,7 +358,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         for (mu, &i) in self.mu.iter_mut().zip(rows) {
             *mu = self.vel[i];
         }
-        self.lu_v.solve_vec(&mut self.mu[..rows.len()]);
+        self.lu_v.solve(&mut self.mu[..rows.len()]);
         let jac = self.ws.jacobian();
         for (&i, mu) in rows.iter().zip(&self.mu) {
             for (v, a) in self.qd.iter_mut().zip(&jac[i * n..(i + 1) * n]) {
