@@ -22,7 +22,8 @@ use super::formulation::Correction;
 use super::stepper::Stepper;
 use super::system::System;
 use super::trajectory::{Monitors, Run, Stats, Trajectory};
-use super::{Output, Simulation};
+use super::{Formulation, Output, Simulation};
+use crate::assembly::write_prescription;
 use crate::kinematics::KinematicsError;
 use crate::ode::{OdeError, OdeOptions, OdeSystem, Tolerances};
 use crate::workspace::EvalError;
@@ -230,10 +231,16 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         coordinates: &pq,
         velocities: &pqd,
     };
-    sys.kin
-        .assemble(mech, &mut sys.point.ws, t0, &mut q, &mut qd, &prescription)
-        .map_err(|e| empty(assembly_error(e)))?;
-    sys.point.invalidate();
+    if sim.formulation == Formulation::Unconstrained {
+        // Nothing to enforce, nothing to assemble: the state as given.
+        write_prescription(info, t0, &mut q, &mut qd, &prescription)
+            .map_err(|e| empty(assembly_error(e)))?;
+    } else {
+        sys.kin
+            .assemble(mech, &mut sys.point.ws, t0, &mut q, &mut qd, &prescription)
+            .map_err(|e| empty(assembly_error(e)))?;
+        sys.point.invalidate();
+    }
     sys.point.q.copy_from_slice(&q);
     sys.point.qd.copy_from_slice(&qd);
     sys.point.redundant = sys.fit_rows();

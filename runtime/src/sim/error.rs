@@ -29,6 +29,8 @@ pub enum SingularMatrix {
     },
     /// $J J^\mathsf{T}$ (or $C_q C_q^\mathsf{T}$) in a projection.
     Projection,
+    /// The mass matrix (unconstrained formulation: not positive definite).
+    Mass,
 }
 
 impl fmt::Display for SingularMatrix {
@@ -38,6 +40,7 @@ impl fmt::Display for SingularMatrix {
             Self::DependentVelocities => f.write_str("dependent velocity Jacobian `J_d`"),
             Self::Augmented { rank } => write!(f, "augmented matrix (rank of `J` {rank})"),
             Self::Projection => f.write_str("projection matrix `J J^T`"),
+            Self::Mass => f.write_str("mass matrix `M`"),
         }
     }
 }

@@ -12,6 +12,7 @@
 //! | [`Partitioned`] | the point of the chart of the last accepted state | polished to the Newton tolerance; the derivative stays valid | the chart's Newton, a singular projection |
 //! | [`Projected`] | $y$ as it is | projected on $C = 0$, $J\dot q + c = 0$ | none |
 //! | [`Stabilized`] | $y$ as it is | as they are | none |
+//! | [`Free`] | $y$ as it is | as they are | none |
 
 use super::chart::{Chart, ChartFailure};
 use super::error::{SimErrorKind, SingularMatrix};
@@ -329,6 +330,52 @@ impl Form for Stabilized {
     }
 }
 
+/// $M\ddot q = Q$ without multipliers ([`Formulation::Unconstrained`]).
+#[derive(Debug)]
+pub(crate) struct Free;
+
+impl Form for Free {
+    const CORRECTION: Correction = Correction::None;
+
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        _: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        copy_state(p, y);
+        Ok(())
+    }
+
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.free_accelerations(t)
+    }
+
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn recoverable(&self, _: &SimErrorKind) -> bool {
+        false
+    }
+}
+
 /// The formulation chosen at run time.
 // One lives per run, so the size of the largest variant (the chart's scratch) costs
 // nothing worth a box.
@@ -338,6 +385,7 @@ pub(crate) enum AnyForm {
     Partitioned(Partitioned),
     Projected(Projected),
     Stabilized(Stabilized),
+    Free(Free),
 }
 
 impl AnyForm {
@@ -350,6 +398,7 @@ impl AnyForm {
             Formulation::Baumgarte { alpha, beta } => {
                 Self::Stabilized(Stabilized::new(alpha, beta, m))
             }
+            Formulation::Unconstrained => Self::Free(Free),
         }
     }
 
@@ -359,6 +408,7 @@ impl AnyForm {
             Self::Partitioned(_) => Partitioned::CORRECTION,
             Self::Projected(_) => Projected::CORRECTION,
             Self::Stabilized(_) => Stabilized::CORRECTION,
+            Self::Free(_) => Free::CORRECTION,
         }
     }
 }
@@ -369,6 +419,7 @@ macro_rules! each {
             AnyForm::Partitioned($f) => $body,
             AnyForm::Projected($f) => $body,
             AnyForm::Stabilized($f) => $body,
+            AnyForm::Free($f) => $body,
         }
     };
 }

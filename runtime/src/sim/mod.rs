@@ -47,6 +47,12 @@
 //!   [`Formulation::baumgarte`] gives the defaults $\alpha = \beta = 10\ \text{s}^{-1}$
 //!   (critical damping, time constant 0.1 s; choose them a few times faster than the
 //!   motion of interest and slower than what the step size can resolve).
+//! - [`Formulation::Unconstrained`]: Lagrange's equations of the second kind in all
+//!   coordinates, $M\ddot q = Q$, without multipliers (math-spec (S2-22)): the
+//!   constraints are not enforced. When the applied forces make the motion free
+//!   (math-spec §8) they hold by themselves, and the monitors measure how well. The
+//!   initial state is taken as given (prescriptions are written into it, nothing is
+//!   assembled); $M$ is factored densely.
 //!
 //! # Example
 //! ```
@@ -132,6 +138,8 @@ pub enum Formulation {
     Partitioning,
     /// Index 1 with projection of positions and velocities after each step.
     Projection,
+    /// $M\ddot q = Q$ in all coordinates, without multipliers (math-spec (S2-22)).
+    Unconstrained,
     /// Index 1 with Baumgarte stabilization.
     Baumgarte {
         /// Velocity-level gain $\alpha$ [1/s].
@@ -151,7 +159,8 @@ impl Formulation {
         }
     }
 
-    /// The three formulations (Baumgarte with its defaults).
+    /// The three formulations that enforce the constraints (Baumgarte with its
+    /// defaults).
     pub const ALL: [Self; 3] = [Self::Partitioning, Self::Projection, Self::baumgarte()];
 
     /// A short name.
@@ -161,6 +170,7 @@ impl Formulation {
             Self::Partitioning => "partitioning",
             Self::Projection => "projection",
             Self::Baumgarte { .. } => "baumgarte",
+            Self::Unconstrained => "unconstrained",
         }
     }
 }

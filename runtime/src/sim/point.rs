@@ -86,6 +86,8 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     mu: Vec<f64>,
     lu_h: SmallCholesky,
     lu_v: SmallCholesky,
+    /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
+    mass: SmallCholesky,
     /// The constraint rows projected on, the first `rows_h` holonomic (all rows unless
     /// assembly dropped redundant ones, see [`Point::fit_rows`]).
     pub rows: Vec<usize>,
@@ -124,6 +126,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             mu: vec![0.0; m],
             lu_h: SmallCholesky::new(mh),
             lu_v: SmallCholesky::new(m),
+            mass: SmallCholesky::new(0),
             rows: (0..m).collect(),
             rows_h: mh,
             constraints: Stamp::new(n, false),
@@ -257,6 +260,47 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.redundant.is_empty() {
             self.redundant.extend(self.dynamics.redundant_constraints());
         }
+        Ok(())
+    }
+
+    /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
+    /// $\lambda = 0$.
+    pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if self.solved.check(t, &self.q, &self.qd) {
+            return Ok(());
+        }
+        if !self.terms.check(t, &self.q, &self.qd) {
+            self.jacobian.valid = false;
+            self.ws
+                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
+                .map_err(SimErrorKind::from_eval)?;
+            self.terms.set(t, &self.q, &self.qd);
+            self.jacobian.set(t, &self.q, &[]);
+        }
+        let info = self.info;
+        let n = info.nq();
+        if self.mass.matrix_mut().len() != n * n {
+            self.mass = SmallCholesky::new(n);
+        }
+        let a = self.mass.matrix_mut();
+        a.fill(0.0);
+        for (&(r, c), &v) in info.mass_pattern.iter().zip(&self.ws.mass_values) {
+            a[r as usize * n + c as usize] = v;
+        }
+        self.factorizations += 1;
+        let ratio = self.mass.factor().ratio();
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Mass,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
+        self.qdd.copy_from_slice(&self.ws.forces);
+        self.mass.solve(&mut self.qdd);
+        self.lambda.fill(0.0);
+        self.solved.set(t, &self.q, &self.qd);
         Ok(())
     }
 
