@@ -37,6 +37,28 @@ pub struct AssemblyReport {
     pub velocity_residual: f64,
 }
 
+/// A declared initial velocity that the constraints determine from the others (see
+/// [`Kinematics::assemble_declared`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverriddenVelocity {
+    /// The coordinate.
+    pub coordinate: &'static str,
+    /// The velocity declared.
+    pub declared: f64,
+    /// The velocity the constraints gave it.
+    pub used: f64,
+}
+
+impl std::fmt::Display for OverriddenVelocity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the declared initial velocity of `{}` ({}) is determined by the constraints from the others: {} was used",
+            self.coordinate, self.declared, self.used
+        )
+    }
+}
+
 /// Errors of assembly.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum AssemblyError {
@@ -163,6 +185,74 @@ impl Kinematics {
             velocity_correction: diff(qd, &qd0),
             velocity_residual,
         })
+    }
+}
+
+impl Kinematics {
+    /// [`assemble`](Self::assemble), also holding the non-zero velocities of the guess
+    /// (a model's declared `qd0`) where the constraints allow it: each is prescribed
+    /// like the velocities of `prescription`, and one that the constraints determine
+    /// from the others (Algorithm P must make it dependent) is released to K2 and
+    /// reported with the value used. Without this, K2 keeps the velocities of whichever
+    /// coordinates Algorithm P leaves independent, and a declared velocity of a
+    /// dependent coordinate is silently replaced (a model `x` with `qd0: 1` tied to `y`
+    /// by `y - x = 0` would start at rest).
+    ///
+    /// # Errors
+    /// As [`assemble`](Self::assemble).
+    pub fn assemble_declared<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        prescription: &Prescription<'_>,
+    ) -> Result<(AssemblyReport, Vec<OverriddenVelocity>), AssemblyError> {
+        let info = ws.info();
+        check_state(info, t, q, Some(qd))?;
+        let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
+        let given = velocities.len();
+        let declared: Vec<(&'static str, f64)> = info
+            .coordinates
+            .iter()
+            .zip(qd.iter())
+            .filter(|&(c, &v)| v != 0.0 && !velocities.iter().any(|g| g.0 == c.name))
+            .map(|(c, &v)| (c.name, v))
+            .collect();
+        velocities.extend(declared.iter().copied());
+        let (q0, qd0) = (q.to_vec(), qd.to_vec());
+        loop {
+            let held = Prescription {
+                coordinates: prescription.coordinates,
+                velocities: &velocities,
+            };
+            match self.assemble(mech, ws, t, q, qd, &held) {
+                Ok(report) => {
+                    let overridden = declared
+                        .iter()
+                        .filter_map(|&(name, v)| {
+                            let i = info.coordinate_index(name)?;
+                            ((qd[i] - v).abs() > 1e-9 * v.abs()).then_some(OverriddenVelocity {
+                                coordinate: name,
+                                declared: v,
+                                used: qd[i],
+                            })
+                        })
+                        .collect();
+                    return Ok((report, overridden));
+                }
+                Err(AssemblyError::Partition(PartitionError::PrescribedVelocity {
+                    coordinate,
+                    ..
+                })) if velocities[given..].iter().any(|h| h.0 == coordinate) => {
+                    velocities.retain(|h| h.0 != coordinate);
+                    q.copy_from_slice(&q0);
+                    qd.copy_from_slice(&qd0);
+                }
+                Err(e) => return Err(e),
+            }
+        }
     }
 }
 

@@ -293,7 +293,10 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         elim.tier[i] = Tier::Allowed;
     }
     let ph1 = elim.phase(0, mh, mh, params.pivot_tolerance);
-    if ph1.rank < mh && params.allow_redundant && m == mh && ph1.first_allowed.is_none() {
+    // Redundant rows are allowed: a prescription that could not be kept out of β is
+    // the error to report (below), else the rows left without a pivot are dropped.
+    let redundant_allowed = params.allow_redundant && m == mh;
+    if ph1.rank < mh && redundant_allowed && ph1.first_allowed.is_none() {
         let r = ph1.rank;
         let mut rows = elim.rows[..r].to_vec();
         let mut redundant = elim.rows[r..mh].to_vec();
@@ -314,7 +317,7 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
             time: t,
         });
     }
-    if ph1.rank < mh {
+    if ph1.rank < mh && !redundant_allowed {
         return Err(PartitionError::RedundantHolonomic {
             t,
             constraints: names(&elim.rows[ph1.rank..mh]),

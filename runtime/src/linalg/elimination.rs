@@ -13,7 +13,17 @@
 //! after a phase over the holonomic rows the non-holonomic rows hold the Schur
 //! complement $\hat G = G_p - G_\beta C_\beta^{-1} C_p$ (Algorithm P, step 2).
 //!
+//! **Equilibration.** [`Elimination::load`] scales each row by a power of two to a
+//! largest magnitude near 1 (see [`DenseLu`](super::dense::DenseLu)), so that pivot
+//! choices and rank decisions do not depend on the units of the constraints. Columns are
+//! not scaled: which coordinate becomes dependent is decided by comparing the
+//! derivatives of a constraint with respect to the coordinates, which scaling each
+//! column by its own largest entry would equalize (the single row of a pendulum,
+//! $[2x, 2y]$, would no longer say that $x$ is the better pivot near $y = 0$).
+//!
 //! Invariant: no allocation after [`Elimination::new`].
+
+use super::dense::power_of_two_inverse;
 
 /// How a column may be chosen as a pivot column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,10 +92,16 @@ impl Elimination {
         }
     }
 
-    /// Copies the first `m` rows of the row-major `a` (row length `n`), resets the
-    /// permutations and marks every column preferred.
+    /// Copies the first `m` rows of the row-major `a` (row length `n`), scales each to a
+    /// largest magnitude near 1, resets the permutations and marks every column
+    /// preferred.
     pub fn load(&mut self, a: &[f64]) {
-        self.a.copy_from_slice(&a[..self.m * self.n]);
+        let (m, n) = (self.m, self.n);
+        self.a.copy_from_slice(&a[..m * n]);
+        for row in self.a.chunks_exact_mut(n.max(1)).take(m) {
+            let s = power_of_two_inverse(row.iter().fold(0.0_f64, |b, v| b.max(v.abs())));
+            row.iter_mut().for_each(|v| *v *= s);
+        }
         for (k, r) in self.rows.iter_mut().enumerate() {
             *r = k;
         }

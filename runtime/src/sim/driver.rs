@@ -83,6 +83,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     monitors: Monitors,
     started: Instant,
     y: &'a mut [f64],
+    overridden: Vec<crate::OverriddenVelocity>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -147,6 +148,20 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         }
     }
 
+    /// Adds a row at the integrator's last accepted state when the rows end before it
+    /// (output on a grid, or only at the end), so that a partial run ends where the
+    /// integration stopped. Skipped when the state cannot be reconstructed.
+    fn record_last_accepted(&mut self, stepper: &Stepper) {
+        let t = stepper.t();
+        if self.traj.t.last().is_some_and(|&last| last >= t) || self.y.len() != stepper.y().len() {
+            return;
+        }
+        self.y.copy_from_slice(stepper.y());
+        if self.sys.reconstruct(t, self.y).is_ok() {
+            let _ = self.record(t);
+        }
+    }
+
     fn run(&self, stepper: Option<&Stepper>) -> Run {
         let mut stats = Stats {
             newton_iterations: self.sys.newton_iterations,
@@ -167,6 +182,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats,
             monitors: self.monitors,
             redundant_constraints: self.sys.redundant.clone(),
+            overridden_velocities: self.overridden.clone(),
         }
     }
 
@@ -177,6 +193,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             if constraints.is_empty() {
                 *constraints = self.nearly_dependent();
             }
+        }
+        if let Some(s) = stepper {
+            self.record_last_accepted(s);
         }
         SimError {
             kind,
@@ -222,6 +241,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             },
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
+            overridden_velocities: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -262,8 +282,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         coordinates: &pq,
         velocities: &pqd,
     };
-    sys.kin
-        .assemble(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
+    let (_, overridden) = sys
+        .kin
+        .assemble_declared(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
         .map_err(|e| empty(assembly_error(e)))?;
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
@@ -290,6 +311,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         monitors: Monitors::default(),
         started,
         y: &mut y,
+        overridden,
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -317,7 +339,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
-        h_init: sim.h_init,
+        h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
         h_max,
         max_steps: sim.max_steps,
         dense_output: true,

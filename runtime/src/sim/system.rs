@@ -19,6 +19,7 @@ use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams};
 use crate::linalg::dense::DenseLu;
 use crate::linalg::inf_norm;
 use crate::ode::{OdeSystem, RhsError};
+use crate::scale;
 use crate::workspace::{EvalError, Workspace};
 use crate::{Error, Info, Mechanism};
 
@@ -323,15 +324,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         if let KinematicsError::SingularDependent { .. }
         | KinematicsError::SingularVelocity { .. } = e
         {
-            let tol = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
-            self.failure_constraints = self
-                .ws
-                .constraints()
-                .iter()
-                .zip(self.info.holonomic)
-                .filter(|(c, _)| c.is_nan() || c.abs() > tol)
-                .map(|(_, s)| s.name)
-                .collect();
+            let tol = self.kin.params().newton.tolerance;
+            self.failure_constraints = self.violated(tol);
         }
     }
 
@@ -415,8 +409,10 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     .eval_constraints(self.mech, t, &self.q)
                     .map_err(eval)?;
                 let residual = inf_norm(self.ws.constraints());
-                let bound = newton.tolerance * (1.0 + inf_norm(&self.q));
-                if residual <= bound {
+                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+                let tol = newton.tolerance;
+                let size = scale::coordinate_size(&self.q);
+                if scale::all_met(self.ws.constraints(), &self.ws.jacobian, n, tol, size) {
                     break;
                 }
                 if iterations == newton.max_iterations || !residual.is_finite() {
@@ -424,10 +420,9 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                         t,
                         iterations,
                         residual,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(tol),
                     });
                 }
-                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
                 let rows = &self.rows[..self.rows_h];
                 let ratio = gram(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
@@ -435,7 +430,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                         t,
                         matrix: SingularMatrix::Projection,
                         ratio,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(tol),
                     });
                 }
                 for (mu, &i) in self.mu.iter_mut().zip(rows) {
@@ -481,14 +476,20 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         Ok(())
     }
 
-    fn violated(&self, bound: f64) -> Vec<&'static str> {
-        self.ws
-            .constraints()
-            .iter()
-            .zip(self.info.holonomic)
-            .filter(|(c, _)| c.is_nan() || c.abs() > bound)
-            .map(|(_, s)| s.name)
-            .collect()
+    /// The holonomic constraints not met to the relative `tolerance` at the last
+    /// evaluation of $C$ and $C_q$ (see [`crate::scale`]).
+    fn violated(&self, tolerance: f64) -> Vec<&'static str> {
+        let size = scale::coordinate_size(&self.q);
+        let n = self.info.nq();
+        scale::unmet(
+            self.ws.constraints(),
+            self.ws.jacobian(),
+            n,
+            tolerance,
+            size,
+        )
+        .map(|i| self.info.holonomic[i].name)
+        .collect()
     }
 
     fn rhs_inner(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
@@ -567,7 +568,7 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
         }
         let r = self.reconstruct(t, y).and_then(|()| {
             let sign = self.kin.dependent_sign();
-            let floor = BRANCH_FLOOR * (1.0 + inf_norm(&self.q));
+            let floor = BRANCH_FLOOR * scale::coordinate_size(&self.q);
             if (self.sign_acc != 0.0 && sign != self.sign_acc)
                 || self.correction > self.moved + floor
             {
