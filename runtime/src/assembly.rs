@@ -190,16 +190,18 @@ impl Kinematics {
 
 impl Kinematics {
     /// [`assemble`](Self::assemble), also holding the non-zero velocities of the guess
-    /// (a model's declared `qd0`) where the constraints allow it: each is prescribed
-    /// like the velocities of `prescription`, and one that the constraints determine
-    /// from the others (Algorithm P must make it dependent) is released to K2 and
-    /// reported with the value used. Without this, K2 keeps the velocities of whichever
-    /// coordinates Algorithm P leaves independent, and a declared velocity of a
-    /// dependent coordinate is silently replaced (a model `x` with `qd0: 1` tied to `y`
-    /// by `y - x = 0` would start at rest).
+    /// (a model's declared `qd0`) where the constraints allow it, and reporting the
+    /// ones they determine from the others with the value used. Without this, K2 keeps
+    /// the velocities of whichever coordinates Algorithm P leaves independent, and a
+    /// declared velocity of a dependent coordinate is silently replaced (a model `x`
+    /// with `qd0: 1` tied to `y` by `y - x = 0` would start at rest).
+    ///
+    /// Greedy: after the plain assembly, each declared velocity that it changed is
+    /// added to the prescription if the assembly still succeeds with it, in the order
+    /// of the coordinates; the prescription's own values always come first.
     ///
     /// # Errors
-    /// As [`assemble`](Self::assemble).
+    /// As [`assemble`](Self::assemble) with `prescription` alone.
     pub fn assemble_declared<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -211,48 +213,59 @@ impl Kinematics {
     ) -> Result<(AssemblyReport, Vec<OverriddenVelocity>), AssemblyError> {
         let info = ws.info();
         check_state(info, t, q, Some(qd))?;
-        let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
-        let given = velocities.len();
         let declared: Vec<(&'static str, f64)> = info
             .coordinates
             .iter()
             .zip(qd.iter())
-            .filter(|&(c, &v)| v != 0.0 && !velocities.iter().any(|g| g.0 == c.name))
+            .filter(|&(c, &v)| v != 0.0 && !prescription.velocities.iter().any(|g| g.0 == c.name))
             .map(|(c, &v)| (c.name, v))
             .collect();
-        velocities.extend(declared.iter().copied());
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
-        loop {
+        self.assemble(mech, ws, t, q, qd, prescription)?;
+        let changed = |qd: &[f64], (name, v): (&'static str, f64)| {
+            let i = info
+                .coordinate_index(name)
+                .expect("a coordinate of the model");
+            ((qd[i] - v).abs() > 1e-9 * v.abs()).then_some(OverriddenVelocity {
+                coordinate: name,
+                declared: v,
+                used: qd[i],
+            })
+        };
+        let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
+        // The velocities of the last successful assembly.
+        let mut assembled = qd.to_vec();
+        for &d in &declared {
+            if changed(&assembled, d).is_none() {
+                continue;
+            }
+            velocities.push(d);
             let held = Prescription {
                 coordinates: prescription.coordinates,
                 velocities: &velocities,
             };
-            match self.assemble(mech, ws, t, q, qd, &held) {
-                Ok(report) => {
-                    let overridden = declared
-                        .iter()
-                        .filter_map(|&(name, v)| {
-                            let i = info.coordinate_index(name)?;
-                            ((qd[i] - v).abs() > 1e-9 * v.abs()).then_some(OverriddenVelocity {
-                                coordinate: name,
-                                declared: v,
-                                used: qd[i],
-                            })
-                        })
-                        .collect();
-                    return Ok((report, overridden));
-                }
-                Err(AssemblyError::Partition(PartitionError::PrescribedVelocity {
-                    coordinate,
-                    ..
-                })) if velocities[given..].iter().any(|h| h.0 == coordinate) => {
-                    velocities.retain(|h| h.0 != coordinate);
-                    q.copy_from_slice(&q0);
-                    qd.copy_from_slice(&qd0);
-                }
-                Err(e) => return Err(e),
+            q.copy_from_slice(&q0);
+            qd.copy_from_slice(&qd0);
+            if self.assemble(mech, ws, t, q, qd, &held).is_ok() {
+                assembled.copy_from_slice(qd);
+            } else {
+                velocities.pop();
             }
         }
+        // The last trial may have failed: assemble once more with what held, which
+        // leaves its partition current.
+        let held = Prescription {
+            coordinates: prescription.coordinates,
+            velocities: &velocities,
+        };
+        q.copy_from_slice(&q0);
+        qd.copy_from_slice(&qd0);
+        let report = self.assemble(mech, ws, t, q, qd, &held)?;
+        let overridden = declared
+            .into_iter()
+            .filter_map(|d| changed(qd, d))
+            .collect();
+        Ok((report, overridden))
     }
 }
 

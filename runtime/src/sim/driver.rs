@@ -33,8 +33,9 @@ use crate::{
 /// Relative progress below which a recovery counts as a stall.
 const STALL: f64 = 1e-10;
 
-/// Pivot ratio below which constraints are reported as nearly dependent in a failure.
-const NEAR_SINGULAR: f64 = 1e-3;
+/// Pivot ratios below which constraints are reported as nearly dependent in a failure,
+/// tried in turn.
+const NEAR_SINGULAR: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
 /// Most rows an [`Output::Every`] grid may ask for: a finer grid is a mistake (a unit
 /// error) whose rows would not fit in memory; [`Output::Steps`] records every step.
@@ -124,28 +125,32 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     }
 
     /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
-    /// below [`NEAR_SINGULAR`]) at the last full state: those that lock the mechanism
+    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state: those that lock the mechanism
     /// when an iteration stalls on a singular Jacobian with a small residual.
     fn nearly_dependent(&mut self) -> Vec<&'static str> {
         let sys = &mut self.sys;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
         };
-        let params = PartitionParams {
-            pivot_tolerance: NEAR_SINGULAR,
-            ..PartitionParams::default()
-        };
-        match Partition::compute(
-            sys.mech,
-            &mut sys.ws,
-            t,
-            &sys.q,
-            Preferences::default(),
-            &params,
-        ) {
-            Err(PartitionError::RedundantHolonomic { constraints, .. }) => constraints,
-            _ => Vec::new(),
+        // The weakest rows first: a stall near a fold (a slider at its reach) leaves a
+        // pivot ratio of a few 1e-3 at the last accepted state.
+        for tolerance in NEAR_SINGULAR {
+            let params = PartitionParams {
+                pivot_tolerance: tolerance,
+                ..PartitionParams::default()
+            };
+            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) = Partition::compute(
+                sys.mech,
+                &mut sys.ws,
+                t,
+                &sys.q,
+                Preferences::default(),
+                &params,
+            ) {
+                return constraints;
+            }
         }
+        Vec::new()
     }
 
     /// Adds a row at the integrator's last accepted state when the rows end before it
@@ -187,15 +192,15 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     }
 
     fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+        if let Some(s) = stepper {
+            self.record_last_accepted(s);
+        }
         if let SimErrorKind::NewtonFailed { constraints, .. }
         | SimErrorKind::Singular { constraints, .. } = &mut kind
         {
             if constraints.is_empty() {
                 *constraints = self.nearly_dependent();
             }
-        }
-        if let Some(s) = stepper {
-            self.record_last_accepted(s);
         }
         SimError {
             kind,

@@ -6,6 +6,7 @@
 //! test.
 
 mod andrews;
+mod declared;
 mod exact;
 mod faults;
 mod models;
