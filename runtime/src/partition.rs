@@ -13,8 +13,11 @@
 //! Then $J_d = \begin{bmatrix}C_\beta & C_\eta\\ G_\beta & G_\eta\end{bmatrix}$ is
 //! non-singular with $|\det J_d| = |\det C_\beta|\,|\det \hat G_\eta|$.
 //!
-//! A pivot below `pivot_tolerance` × (largest entry) means redundant or singular
-//! constraints: the rows left without a pivot are reported by name.
+//! Pivots are chosen on $J$ with its columns weighted by the units of the coordinates
+//! and its rows scaled to a largest entry near 1 (see [`crate::scale`]), so that the
+//! partition does not depend on the units of the model. A pivot below
+//! `pivot_tolerance` × (largest entry) means redundant or singular constraints: the
+//! rows left without a pivot are reported by name.
 //!
 //! **Condition monitor.** The partition stores, per block, the ratio
 //! $\rho = \min_k |u_{kk}| / \max_{ij} |a_{ij}|$ of the smallest pivot of $C_\beta$
@@ -275,7 +278,8 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
     let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
     check_state(info, t, q, None)?;
     ws.eval_jacobian(mech, t, q)?;
-    elim.load(&ws.jacobian);
+    ws.eval_weights(mech, t, q)?;
+    elim.load_weighted(&ws.jacobian, Some(&ws.weights));
     let names = |rows: &[usize]| -> Vec<&'static str> {
         rows.iter()
             .map(|&r| {
@@ -402,7 +406,12 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
     let (mh, m) = (info.nh(), info.nh() + info.nnh());
     check_state(info, t, q, None)?;
     ws.eval_jacobian(mech, t, q)?;
-    elim.load(&ws.jacobian);
+    ws.eval_weights(mech, t, q)?;
+    elim.load_weighted(&ws.jacobian, Some(&ws.weights));
+    // The dropped redundant rows do not enter K1 and K2: the kept ones must stay
+    // regular on β (at the bottom of the parallelogram's swing its three pin_y rows
+    // become dependent, and a partition that dropped a pin_x row must be renewed).
+    elim.clear_rows(&partition.redundant);
     elim.tier.fill(Tier::Forbidden);
     for &i in &partition.dependent {
         elim.tier[i] = Tier::Preferred;

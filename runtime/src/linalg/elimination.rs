@@ -15,8 +15,10 @@
 //!
 //! **Equilibration.** [`Elimination::load`] scales each row by a power of two to a
 //! largest magnitude near 1 (see [`DenseLu`](super::dense::DenseLu)), so that pivot
-//! choices and rank decisions do not depend on the units of the constraints. Columns are
-//! not scaled: which coordinate becomes dependent is decided by comparing the
+//! choices and rank decisions do not depend on the units of the constraints.
+//! [`Elimination::load_weighted`] first weights the columns by the units of the
+//! coordinates ([`crate::scale::inertia_weights`]). Columns are not equilibrated by
+//! their own entries: which coordinate becomes dependent is decided by comparing the
 //! derivatives of a constraint with respect to the coordinates, which scaling each
 //! column by its own largest entry would equalize (the single row of a pendulum,
 //! $[2x, 2y]$, would no longer say that $x$ is the better pivot near $y = 0$).
@@ -96,8 +98,19 @@ impl Elimination {
     /// largest magnitude near 1, resets the permutations and marks every column
     /// preferred.
     pub fn load(&mut self, a: &[f64]) {
+        self.load_weighted(a, None);
+    }
+
+    /// [`load`](Self::load) with column `j` multiplied by `weights[j]` first (the units
+    /// of the coordinates, see [`crate::scale`]).
+    pub fn load_weighted(&mut self, a: &[f64], weights: Option<&[f64]>) {
         let (m, n) = (self.m, self.n);
         self.a.copy_from_slice(&a[..m * n]);
+        if let Some(w) = weights {
+            for row in self.a.chunks_exact_mut(n.max(1)).take(m) {
+                row.iter_mut().zip(w).for_each(|(v, w)| *v *= w);
+            }
+        }
         for row in self.a.chunks_exact_mut(n.max(1)).take(m) {
             let s = power_of_two_inverse(row.iter().fold(0.0_f64, |b, v| b.max(v.abs())));
             row.iter_mut().for_each(|v| *v *= s);
@@ -109,6 +122,15 @@ impl Elimination {
             *c = k;
         }
         self.tier.fill(Tier::Preferred);
+    }
+
+    /// Zeroes the rows `rows` (original indices, before any phase) so that no pivot is
+    /// taken from them.
+    pub fn clear_rows(&mut self, rows: &[usize]) {
+        let n = self.n;
+        for &i in rows {
+            self.a[i * n..(i + 1) * n].fill(0.0);
+        }
     }
 
     /// Eliminates up to `count` pivots at positions `k0..k0+count`, with candidate rows

@@ -402,6 +402,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
         let newton = self.kin.params().newton;
         let eval = |e: EvalError| SimErrorKind::from_eval(e);
+        // One renewal of the dropped redundant rows per projection (see `refit`).
+        let mut refitted = false;
         if mh > 0 {
             let mut iterations = 0;
             loop {
@@ -423,8 +425,17 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                         constraints: self.violated(tol),
                     });
                 }
+                let ratio = gram(
+                    &mut self.lu_h,
+                    &self.ws.jacobian,
+                    &self.rows[..self.rows_h],
+                    n,
+                );
+                if (ratio.is_nan() || ratio <= SINGULAR_RATIO) && !refitted && self.refit(t) {
+                    refitted = true;
+                    continue;
+                }
                 let rows = &self.rows[..self.rows_h];
-                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
@@ -451,8 +462,12 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         if m > 0 {
             self.velocity_terms(t).map_err(eval)?;
             self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+            let mut ratio = gram(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
+            if (ratio.is_nan() || ratio <= SINGULAR_RATIO) && !refitted && self.refit(t) {
+                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+                ratio = gram(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
+            }
             let rows = &self.rows[..];
-            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, rows, n);
             self.factorizations += 1;
             if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                 return Err(SimErrorKind::Singular {
@@ -474,6 +489,29 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             }
         }
         Ok(())
+    }
+
+    /// Renews the redundant holonomic rows left out of the projection, when there are
+    /// any: which rows of a dependent set are independent changes along the motion (the
+    /// three pin_y rows of the parallelogram become dependent at the bottom of its
+    /// swing). Returns whether the rows were renewed.
+    fn refit(&mut self, t: f64) -> bool {
+        let redundant = self
+            .kin
+            .partition()
+            .is_some_and(|p| !p.redundant_rows().is_empty());
+        if !redundant {
+            return false;
+        }
+        let rank = self.rows_h;
+        let ok = self
+            .kin
+            .repartition(self.mech, &mut self.ws, t, &self.q)
+            .is_ok_and(|p| p.holonomic_rows().len() == rank);
+        if ok {
+            self.fit_rows();
+        }
+        ok
     }
 
     /// The holonomic constraints not met to the relative `tolerance` at the last

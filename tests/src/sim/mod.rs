@@ -15,3 +15,4 @@ mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
+mod units;
