@@ -338,8 +338,7 @@ impl Dynamics {
         }
         let J = &ws.jacobian;
         let mut elim = Elimination::new(m, n);
-        crate::scale::inertia_weights(info.mass_pattern, &ws.mass_values, &mut ws.weights);
-        elim.load_weighted(J, Some(&ws.weights));
+        elim.load(J);
         // The constraint block of the augmented matrix has pivots of the order of those
         // of J M⁻¹ Jᵀ, the squares of J's: rows of J whose pivot ratio is below the
         // square root of the tolerance are what made the augmented matrix fail it (near

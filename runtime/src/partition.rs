@@ -13,11 +13,10 @@
 //! Then $J_d = \begin{bmatrix}C_\beta & C_\eta\\ G_\beta & G_\eta\end{bmatrix}$ is
 //! non-singular with $|\det J_d| = |\det C_\beta|\,|\det \hat G_\eta|$.
 //!
-//! Pivots are chosen on $J$ with its columns weighted by the units of the coordinates
-//! and its rows scaled to a largest entry near 1 (see [`crate::scale`]), so that the
-//! partition does not depend on the units of the model. A pivot below
-//! `pivot_tolerance` × (largest entry) means redundant or singular constraints: the
-//! rows left without a pivot are reported by name.
+//! Pivots are chosen on $J$ with its rows scaled to a largest entry near 1 (see
+//! [`crate::scale`]), so that the partition does not depend on the units of the
+//! constraints. A pivot below `pivot_tolerance` × (largest entry) means redundant or
+//! singular constraints: the rows left without a pivot are reported by name.
 //!
 //! **Condition monitor.** The partition stores, per block, the ratio
 //! $\rho = \min_k |u_{kk}| / \max_{ij} |a_{ij}|$ of the smallest pivot of $C_\beta$
@@ -278,8 +277,7 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
     let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
     check_state(info, t, q, None)?;
     ws.eval_jacobian(mech, t, q)?;
-    ws.eval_weights(mech, t, q)?;
-    elim.load_weighted(&ws.jacobian, Some(&ws.weights));
+    elim.load(&ws.jacobian);
     let names = |rows: &[usize]| -> Vec<&'static str> {
         rows.iter()
             .map(|&r| {
@@ -317,7 +315,7 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
                 holonomic: ph1.ratio(r),
                 nonholonomic: 1.0,
             },
-            abs_det: ph1.abs_det,
+            abs_det: unscaled_det(elim, ph1.abs_det, ph1.rank),
             time: t,
         });
     }
@@ -388,9 +386,17 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
             holonomic: ph1.ratio(mh),
             nonholonomic: ph2.ratio(m - mh),
         },
-        abs_det: ph1.abs_det,
+        abs_det: unscaled_det(elim, ph1.abs_det, ph1.rank),
         time: t,
     })
+}
+
+/// $|\det C_\beta|$ of the original rows from the product of the first `rank` pivots of
+/// the row-scaled matrix.
+fn unscaled_det(elim: &Elimination, scaled: f64, rank: usize) -> f64 {
+    elim.rows[..rank]
+        .iter()
+        .fold(scaled, |d, &r| d / elim.row_scale[r])
 }
 
 /// The condition monitor on a reusable elimination scratch.
@@ -406,8 +412,7 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
     let (mh, m) = (info.nh(), info.nh() + info.nnh());
     check_state(info, t, q, None)?;
     ws.eval_jacobian(mech, t, q)?;
-    ws.eval_weights(mech, t, q)?;
-    elim.load_weighted(&ws.jacobian, Some(&ws.weights));
+    elim.load(&ws.jacobian);
     // The dropped redundant rows do not enter K1 and K2: the kept ones must stay
     // regular on β (at the bottom of the parallelogram's swing its three pin_y rows
     // become dependent, and a partition that dropped a pin_x row must be renewed).

@@ -14,15 +14,6 @@
 //! $s_q$: $|C_i| \le \varepsilon\,\lVert (C_q)_i\rVert_\infty\, s_q$. Changing the unit
 //! of a constraint scales both sides by the same factor, changing the unit of length
 //! scales $C_i$ (or $(C_q)_i$) and $s_q$ together, and a mass unit does not enter.
-//! - **a coordinate's unit**: $1/\sqrt{M_{jj}}$. The kinetic energy
-//!   $\tfrac12 M_{jj}\dot q_j^2$ has the same unit for every coordinate, so
-//!   $\sqrt{M_{jj}}$ carries the inverse unit of $q_j$ (times the root of a mass).
-//!   Weighting column $j$ of $J = [C_q; G]$ by $1/\sqrt{M_{jj}}$ gives all columns one
-//!   unit; scaling each row to a largest entry near 1 then removes the constraints'
-//!   units. Algorithm P and the redundancy search pivot on that matrix, so that their
-//!   choices do not change when lengths are measured in millimetres and angles in
-//!   radians, or the masses in tonnes ([`inertia_weights`]).
-//!
 //! Solves and singularity tests of square matrices equilibrate rows and columns (see
 //! [`crate::linalg::dense`]).
 
@@ -60,28 +51,6 @@ pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, siz
     unmet(c, jacobian, n, tolerance, size).next().is_none()
 }
 
-/// The column weights $w_j = 1/\sqrt{M_{jj}}$ from the pattern values of $M$ (see the
-/// module docs), into `out` (length $n$). A coordinate without a positive finite
-/// diagonal entry (massless) gets the weight of the heaviest one, and all get 1 when
-/// none has mass.
-pub(crate) fn inertia_weights(pattern: crate::Pattern, values: &[f64], out: &mut [f64]) {
-    out.fill(0.0);
-    for (&(r, c), &v) in pattern.iter().zip(values) {
-        if r == c && v > 0.0 && v.is_finite() {
-            out[r as usize] = 1.0 / v.sqrt();
-        }
-    }
-    let fallback = out
-        .iter()
-        .copied()
-        .filter(|&w| w > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let fallback = if fallback.is_finite() { fallback } else { 1.0 };
-    for w in out.iter_mut().filter(|w| **w == 0.0) {
-        *w = fallback;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -98,21 +67,6 @@ mod tests {
             let size = coordinate_size(&[x, y]);
             assert!(all_met(&c, &jacobian, 2, 1e-12, size), "l = {l}");
             assert!(!all_met(&c, &jacobian, 2, 1e-14, size), "l = {l}");
-        }
-    }
-
-    /// A crank angle with inertia m l²/3 and a slider position with mass m: the
-    /// weights follow the units (1/l for the angle relative to the length), and a
-    /// massless coordinate gets the heaviest one's.
-    #[test]
-    fn inertia_weights_carry_the_units_of_the_coordinates() {
-        let pattern: crate::Pattern = &[(0, 0), (1, 1), (2, 2)];
-        for l in [1e-3, 1.0, 1e3] {
-            let mut w = [0.0; 3];
-            inertia_weights(pattern, &[2.0 * l * l / 3.0, 2.0, 0.0], &mut w);
-            let ratio = w[0] / w[1];
-            assert!((ratio * l - 3f64.sqrt()).abs() < 1e-12, "{w:?}");
-            assert_eq!(w[2], w[0].min(w[1]));
         }
     }
 

@@ -276,8 +276,6 @@ pub struct Workspace {
     /// $[\gamma_h; \gamma_{nh}]$ (length $m$).
     pub(crate) gamma: Vec<f64>,
     pub(crate) forces: Vec<f64>,
-    /// Column weights $1/\sqrt{M_{jj}}$ ([`Workspace::eval_weights`]).
-    pub(crate) weights: Vec<f64>,
 }
 
 impl Workspace {
@@ -311,7 +309,6 @@ impl Workspace {
             bias: vec![0.0; mnh],
             gamma: vec![0.0; mh + mnh],
             forces: vec![0.0; n],
-            weights: vec![1.0; n],
         })
     }
 
@@ -460,26 +457,6 @@ impl Workspace {
                 other => other,
             })?;
         }
-        Ok(())
-    }
-
-    /// Evaluates $M$ and from it the column weights $1/\sqrt{M_{jj}}$ that give the
-    /// columns of $J$ one unit (see [`crate::scale`]).
-    pub(crate) fn eval_weights<M: Mechanism + ?Sized>(
-        &mut self,
-        mech: &M,
-        t: f64,
-        q: &[f64],
-    ) -> Result<(), EvalError> {
-        self.check_model(mech, q, None)?;
-        mech.mass_matrix(t, q, &mut self.mass_values);
-        check_finite_pattern(
-            Quantity::MassMatrix,
-            t,
-            self.info.mass_pattern,
-            &self.mass_values,
-        )?;
-        crate::scale::inertia_weights(self.info.mass_pattern, &self.mass_values, &mut self.weights);
         Ok(())
     }
 

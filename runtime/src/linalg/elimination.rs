@@ -15,10 +15,8 @@
 //!
 //! **Equilibration.** [`Elimination::load`] scales each row by a power of two to a
 //! largest magnitude near 1 (see [`DenseLu`](super::dense::DenseLu)), so that pivot
-//! choices and rank decisions do not depend on the units of the constraints.
-//! [`Elimination::load_weighted`] first weights the columns by the units of the
-//! coordinates ([`crate::scale::inertia_weights`]). Columns are not equilibrated by
-//! their own entries: which coordinate becomes dependent is decided by comparing the
+//! choices and rank decisions do not depend on the units of the constraints. Columns
+//! are not equilibrated by their own entries: which coordinate becomes dependent is decided by comparing the
 //! derivatives of a constraint with respect to the coordinates, which scaling each
 //! column by its own largest entry would equalize (the single row of a pendulum,
 //! $[2x, 2y]$, would no longer say that $x$ is the better pivot near $y = 0$).
@@ -47,7 +45,8 @@ pub(crate) struct Phase {
     pub scale: f64,
     /// Smallest pivot magnitude of the phase (`+∞` when `rank == 0`).
     pub min_pivot: f64,
-    /// Product of the pivot magnitudes of the phase.
+    /// Product of the pivot magnitudes of the phase (of the row-scaled matrix; divide
+    /// by the pivot rows' [`Elimination::row_scale`] for the original one).
     pub abs_det: f64,
     /// Position of the first pivot taken from an [`Tier::Allowed`] column, if any.
     pub first_allowed: Option<usize>,
@@ -80,6 +79,8 @@ pub(crate) struct Elimination {
     pub cols: Vec<usize>,
     /// Tier of each *original* column.
     pub tier: Vec<Tier>,
+    /// The factor each *original* row was scaled by at [`Elimination::load`].
+    pub row_scale: Vec<f64>,
 }
 
 impl Elimination {
@@ -91,6 +92,7 @@ impl Elimination {
             rows: (0..m).collect(),
             cols: (0..n).collect(),
             tier: vec![Tier::Preferred; n],
+            row_scale: vec![1.0; m],
         }
     }
 
@@ -98,22 +100,12 @@ impl Elimination {
     /// largest magnitude near 1, resets the permutations and marks every column
     /// preferred.
     pub fn load(&mut self, a: &[f64]) {
-        self.load_weighted(a, None);
-    }
-
-    /// [`load`](Self::load) with column `j` multiplied by `weights[j]` first (the units
-    /// of the coordinates, see [`crate::scale`]).
-    pub fn load_weighted(&mut self, a: &[f64], weights: Option<&[f64]>) {
         let (m, n) = (self.m, self.n);
         self.a.copy_from_slice(&a[..m * n]);
-        if let Some(w) = weights {
-            for row in self.a.chunks_exact_mut(n.max(1)).take(m) {
-                row.iter_mut().zip(w).for_each(|(v, w)| *v *= w);
-            }
-        }
-        for row in self.a.chunks_exact_mut(n.max(1)).take(m) {
+        for (row, scale) in self.a.chunks_exact_mut(n.max(1)).zip(&mut self.row_scale) {
             let s = power_of_two_inverse(row.iter().fold(0.0_f64, |b, v| b.max(v.abs())));
             row.iter_mut().for_each(|v| *v *= s);
+            *scale = s;
         }
         for (k, r) in self.rows.iter_mut().enumerate() {
             *r = k;

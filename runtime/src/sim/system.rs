@@ -26,6 +26,12 @@ use crate::{Error, Info, Mechanism};
 /// Pivot ratio below which the projection matrix counts as singular.
 const SINGULAR_RATIO: f64 = 1e-14;
 
+/// Pivot ratio of the projection matrix (equilibrated $J_R J_R^\mathsf{T}$) below which
+/// the kept rows of a model with redundant constraints are renewed: a ratio of
+/// $10^{-8}$ is a condition of $10^4$ for $J_R$, where the Newton projection starts to
+/// stall long before the matrix is singular.
+const REFIT_RATIO: f64 = 1e-8;
+
 /// Recoverable kinematic failures in a row (since the last accepted step) before a
 /// failure stops the integrator: with the integrators' cut of 4 per failure the step
 /// has then shrunk by $4^{10} \approx 10^6$, and the driver's re-partition is the
@@ -417,6 +423,14 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 if scale::all_met(self.ws.constraints(), &self.ws.jacobian, n, tol, size) {
                     break;
                 }
+                if (iterations == newton.max_iterations || !residual.is_finite())
+                    && !refitted
+                    && self.refit(t)
+                {
+                    refitted = true;
+                    iterations = 0;
+                    continue;
+                }
                 if iterations == newton.max_iterations || !residual.is_finite() {
                     return Err(SimErrorKind::NewtonFailed {
                         t,
@@ -431,7 +445,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     &self.rows[..self.rows_h],
                     n,
                 );
-                if (ratio.is_nan() || ratio <= SINGULAR_RATIO) && !refitted && self.refit(t) {
+                if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
                     refitted = true;
                     continue;
                 }
@@ -463,7 +477,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             self.velocity_terms(t).map_err(eval)?;
             self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
             let mut ratio = gram(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
-            if (ratio.is_nan() || ratio <= SINGULAR_RATIO) && !refitted && self.refit(t) {
+            if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
                 self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
                 ratio = gram(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
             }
