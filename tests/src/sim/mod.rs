@@ -10,6 +10,7 @@ mod declared;
 mod exact;
 mod faults;
 mod models;
+mod partitioning;
 mod pendulum;
 mod redundant;
 mod robustness;

@@ -435,13 +435,19 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         for (r, span) in holonomic_spans.iter().enumerate() {
             let mut roots = vec![c[r], ct[r], gamma_h[r]];
             roots.extend(cq.iter().filter(|e| e.row == idx(r)).map(|e| e.expr));
-            let what = format!("holonomic constraint `{}` or its derivatives", holonomic_names[r].0);
+            let what = format!(
+                "holonomic constraint `{}` or its derivatives",
+                holonomic_names[r].0
+            );
             checks::finite(cx, g, &roots, &what, *span);
         }
         for (r, span) in nonholonomic_spans.iter().enumerate() {
             let mut roots = vec![gb[r], gamma_nh[r]];
             roots.extend(gm.iter().filter(|e| e.row == idx(r)).map(|e| e.expr));
-            let what = format!("non-holonomic constraint `{}` or its derivatives", nonholonomic_names[r].0);
+            let what = format!(
+                "non-holonomic constraint `{}` or its derivatives",
+                nonholonomic_names[r].0
+            );
             checks::finite(cx, g, &roots, &what, *span);
         }
         if let (true, Some(fm)) = (ok, &free_motion) {
