@@ -105,8 +105,9 @@ impl Scene {
             "parallelogram" => Self {
                 // Falling from θ = π/3, the cranks reach the horizontal at t ≈ 0.497 s:
                 // there all three pin_x constraints coincide (a dead-centre, where the
-                // linkage can change branch and C_q loses rank), which coordinate
-                // partitioning cannot cross.
+                // linkage can change branch and C_q loses rank). Partitioning and
+                // projection cross it; Baumgarte's state, off the constraints by its
+                // drift, can make the redundant rows disagree at such points.
                 t_end: 0.45,
                 span: "the swing down to just before the horizontal dead-centre at 0.497 s",
                 steady: None,

@@ -91,15 +91,8 @@ fn scales() -> Vec<Scale> {
     for (mass, length, time) in [(1e-6, 1e-3, 1e3), (1e6, 1e3, 1e-3), (1e6, 1e-3, 1.0)] {
         out.push(Scale { mass, length, time });
     }
-    let mut state = 0x9E37_79B9_7F4A_7C15_u64;
-    let mut uniform = move || {
-        // splitmix64
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        (z ^ (z >> 31)) as f64 / u64::MAX as f64
-    };
+    let mut rng = crate::accuracy::util::Rng::new(0x9E37_79B9_7F4A_7C15);
+    let mut uniform = move || rng.uniform();
     for _ in 0..2 {
         out.push(Scale {
             mass: 10f64.powf(-6.0 + 12.0 * uniform()),
