@@ -44,7 +44,9 @@ mod reactions;
 pub mod sim;
 mod workspace;
 
-pub use assembly::{AssemblyError, AssemblyReport, Prescription};
+pub use assembly::{
+    AssemblyError, AssemblyReport, Prescription, StateLevel, Violation, CONSISTENCY_TOLERANCE,
+};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
     DEFAULT_CROSSOVER,
