@@ -9,11 +9,65 @@
 //! $\gamma$ (an error names the coordinate and the constraints that make this
 //! impossible); Newton K1 on $\beta$; the velocity solve K2 with the non-prescribed
 //! independent velocities taken from the guess.
+//!
+//! **A full state.** When every coordinate is prescribed there is nothing to solve: the
+//! values are checked against the constraints instead, each row $i$ within
+//! [`CONSISTENCY_TOLERANCE`] of its scale,
+//! $|C_i| \le \varepsilon\,(1 + \lVert q\rVert_\infty)\max_j |\partial C_i/\partial q_j|$
+//! (the coordinates are within a relative $\varepsilon$ of meeting the row), and kept
+//! as given; a violation is an [`AssemblyError::Inconsistent`] naming every violated
+//! constraint with its residual. Likewise when every velocity is prescribed, with
+//! $|J_i\dot q + c_i| \le \varepsilon\,(\sum_j |J_{ij}\dot q_j| + |c_i|)$ (up to
+//! round-off when all terms vanish).
 
 use crate::kinematics::{Kinematics, KinematicsError, NewtonStats};
 use crate::partition::{PartitionError, Preferences};
 use crate::workspace::{check_state, EvalError, Workspace};
 use crate::Mechanism;
+
+/// Relative tolerance $\varepsilon$ of the consistency check of a fully prescribed
+/// state (see the module docs): values typed with about ten significant digits pass, a
+/// state off the constraints by more than a hundred-millionth of its size does not.
+pub const CONSISTENCY_TOLERANCE: f64 = 1e-8;
+
+/// Which level of a fully prescribed state violates the constraints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateLevel {
+    /// The coordinates $q$: $C(q, t) = 0$.
+    Positions,
+    /// The velocities $\dot q$: $C_q\dot q + C_t = 0$, $G\dot q + g = 0$.
+    Velocities,
+}
+
+impl std::fmt::Display for StateLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Positions => "coordinates",
+            Self::Velocities => "velocities",
+        })
+    }
+}
+
+/// A constraint violated by a fully prescribed state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Violation {
+    /// The constraint's name.
+    pub constraint: &'static str,
+    /// Its residual ($C_i$, or $J_i\dot q + c_i$).
+    pub residual: f64,
+    /// The largest residual the check accepted for it.
+    pub tolerance: f64,
+}
+
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "`{}` by {:.3e} (tolerance {:.1e})",
+            self.constraint, self.residual, self.tolerance
+        )
+    }
+}
 
 /// Prescribed values by coordinate name.
 #[derive(Clone, Copy, Debug, Default)]
@@ -82,9 +136,25 @@ pub enum AssemblyError {
     /// Newton could not meet the constraints from the guess, or a solve failed.
     #[error("cannot assemble from the guess: {0}")]
     Kinematics(#[from] KinematicsError),
+    /// Every coordinate (or velocity) is prescribed and the values violate the
+    /// constraints.
+    #[error("the prescribed {level} violate the constraints: {}", list(.violated))]
+    Inconsistent {
+        /// Coordinates or velocities.
+        level: StateLevel,
+        /// The violated constraints, in row order.
+        violated: Vec<Violation>,
+    },
     /// Evaluation failed.
     #[error(transparent)]
     Eval(#[from] EvalError),
+}
+
+fn list(v: &[Violation]) -> String {
+    v.iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn resolve(
@@ -160,8 +230,22 @@ impl Kinematics {
             qd[i] = v;
         }
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
-        let pos_idx: Vec<usize> = pos.iter().map(|p| p.0).collect();
-        let vel_idx: Vec<usize> = vel.iter().map(|p| p.0).collect();
+        let n = info.nq();
+        // A full state is checked, not solved for (module docs).
+        let (all_q, all_qd) = (pos.len() == n, vel.len() == n);
+        if all_q {
+            check_positions(mech, ws, t, q)?;
+        }
+        let pos_idx: Vec<usize> = if all_q {
+            Vec::new()
+        } else {
+            pos.iter().map(|p| p.0).collect()
+        };
+        let vel_idx: Vec<usize> = if all_qd {
+            Vec::new()
+        } else {
+            vel.iter().map(|p| p.0).collect()
+        };
         let previous = self.partition.take();
         let prefs = Preferences {
             coordinates: &pos_idx,
@@ -171,8 +255,21 @@ impl Kinematics {
             self.partition = previous;
             return Err(e.into());
         }
-        let newton = self.position(mech, ws, t, q)?;
-        self.velocity(mech, ws, t, q, qd)?;
+        let newton = if all_q {
+            ws.eval_constraints(mech, t, q)?;
+            NewtonStats {
+                iterations: 0,
+                residual: crate::linalg::inf_norm(ws.constraints()),
+                step: 0.0,
+            }
+        } else {
+            self.position(mech, ws, t, q)?
+        };
+        if all_qd {
+            check_velocities(mech, ws, t, q, qd)?;
+        } else {
+            self.velocity(mech, ws, t, q, qd)?;
+        }
         let velocity_residual = velocity_residual(ws, mech, t, q, qd)?;
         let diff = |a: &[f64], b: &[f64]| {
             a.iter()
@@ -266,6 +363,81 @@ impl Kinematics {
             .filter_map(|d| changed(qd, d))
             .collect();
         Ok((report, overridden))
+    }
+}
+
+/// The position check of a full state (module docs).
+fn check_positions<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+) -> Result<(), AssemblyError> {
+    let info = ws.info();
+    let n = info.nq();
+    ws.eval_constraints(mech, t, q)?;
+    ws.eval_jacobian(mech, t, q)?;
+    let size = 1.0 + crate::linalg::inf_norm(q);
+    let violated: Vec<Violation> = (0..info.nh())
+        .filter_map(|i| {
+            let slope = crate::linalg::inf_norm(&ws.jacobian[i * n..(i + 1) * n]);
+            let tolerance = CONSISTENCY_TOLERANCE * size * slope;
+            let residual = ws.c[i];
+            (residual.abs() > tolerance).then_some(Violation {
+                constraint: info.holonomic[i].name,
+                residual,
+                tolerance,
+            })
+        })
+        .collect();
+    if violated.is_empty() {
+        Ok(())
+    } else {
+        Err(AssemblyError::Inconsistent {
+            level: StateLevel::Positions,
+            violated,
+        })
+    }
+}
+
+/// The velocity check of a full state (module docs).
+fn check_velocities<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<(), AssemblyError> {
+    let info = ws.info();
+    let (n, mh) = (info.nq(), info.nh());
+    ws.eval_jacobian(mech, t, q)?;
+    ws.eval_rates(mech, t, q)?;
+    let violated: Vec<Violation> = (0..mh + info.nnh())
+        .filter_map(|i| {
+            let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
+            let row = &ws.jacobian[i * n..(i + 1) * n];
+            let residual = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + c;
+            let scale = row.iter().zip(qd).map(|(a, b)| (a * b).abs()).sum::<f64>() + c.abs();
+            let tolerance = CONSISTENCY_TOLERANCE * scale + f64::MIN_POSITIVE;
+            let name = if i < mh {
+                info.holonomic[i].name
+            } else {
+                info.nonholonomic[i - mh].name
+            };
+            (residual.abs() > tolerance).then_some(Violation {
+                constraint: name,
+                residual,
+                tolerance,
+            })
+        })
+        .collect();
+    if violated.is_empty() {
+        Ok(())
+    } else {
+        Err(AssemblyError::Inconsistent {
+            level: StateLevel::Velocities,
+            violated,
+        })
     }
 }
 

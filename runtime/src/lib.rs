@@ -45,7 +45,10 @@ mod scale;
 pub mod sim;
 mod workspace;
 
-pub use assembly::{AssemblyError, AssemblyReport, OverriddenVelocity, Prescription};
+pub use assembly::{
+    AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
+    CONSISTENCY_TOLERANCE,
+};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
     DEFAULT_CROSSOVER,
