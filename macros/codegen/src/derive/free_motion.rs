@@ -155,7 +155,7 @@ pub fn derive(g: &mut Graph, inputs: &Inputs<'_>) -> Option<FreeMotion> {
 /// (`q1'`), the applied force on coordinate `x` as `Q_x`, parameters by name, e.g.
 /// `2*q1' + t*Q_q1 + 2*Q_q2 - 3*Q_q3` for Example 1 of \[S2\].
 ///
-/// A subexpression of at least [`SHARED_SIZE`] operations that occurs more than once
+/// A subexpression of at least a dozen operations (`SHARED_SIZE`) that occurs more than once
 /// (in one formula or across them) is printed once, as a temporary `#k` defined in a
 /// `where` clause of the first formula that uses it (`… + #1*x', where #1 = …`), so
 /// that the text is linear in the size of the shared graph: printed as a tree, a
