@@ -193,9 +193,15 @@ fn simulate_failure_reports_the_error_and_the_partial_run() {
         .map(String::as_str)
         .collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["kind", "message", "t"]);
-    assert_eq!(v["error"]["kind"], "singular");
+    assert_eq!(keys, ["kind", "message", "stopped_at", "t"]);
+    assert_eq!(v["error"]["kind"], "singular_mass");
     assert_eq!(v["error"]["t"], 0.0);
+    // Nothing consistent was computed: no last state.
+    assert!(v["error"]["stopped_at"].is_null());
+    assert!(v["final"].is_null());
+    // The massless coordinates are named.
+    let message = v["error"]["message"].as_str().unwrap();
+    assert!(message.contains("coordinates involved"), "{message}");
 }
 
 #[test]

@@ -91,6 +91,28 @@ pub struct AssemblyReport {
     pub velocity_residual: f64,
 }
 
+/// A declared initial velocity that the constraints determine from the others (see
+/// [`Kinematics::assemble_declared`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverriddenVelocity {
+    /// The coordinate.
+    pub coordinate: &'static str,
+    /// The velocity declared.
+    pub declared: f64,
+    /// The velocity the constraints gave it.
+    pub used: f64,
+}
+
+impl std::fmt::Display for OverriddenVelocity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the declared initial velocity of `{}` ({}) is determined by the constraints from the others: {} was used",
+            self.coordinate, self.declared, self.used
+        )
+    }
+}
+
 /// Errors of assembly.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum AssemblyError {
@@ -293,6 +315,87 @@ impl Kinematics {
             velocity_correction: diff(qd, &qd0),
             velocity_residual,
         })
+    }
+}
+
+impl Kinematics {
+    /// [`assemble`](Self::assemble), also holding the non-zero velocities of the guess
+    /// (a model's declared `qd0`) where the constraints allow it, and reporting the
+    /// ones they determine from the others with the value used. Without this, K2 keeps
+    /// the velocities of whichever coordinates Algorithm P leaves independent, and a
+    /// declared velocity of a dependent coordinate is silently replaced (a model `x`
+    /// with `qd0: 1` tied to `y` by `y - x = 0` would start at rest).
+    ///
+    /// Greedy: after the plain assembly, each declared velocity that it changed is
+    /// added to the prescription if the assembly still succeeds with it, in the order
+    /// of the coordinates; the prescription's own values always come first.
+    ///
+    /// # Errors
+    /// As [`assemble`](Self::assemble) with `prescription` alone.
+    pub fn assemble_declared<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        prescription: &Prescription<'_>,
+    ) -> Result<(AssemblyReport, Vec<OverriddenVelocity>), AssemblyError> {
+        let info = ws.info();
+        check_state(info, t, q, Some(qd))?;
+        let declared: Vec<(&'static str, f64)> = info
+            .coordinates
+            .iter()
+            .zip(qd.iter())
+            .filter(|&(c, &v)| v != 0.0 && !prescription.velocities.iter().any(|g| g.0 == c.name))
+            .map(|(c, &v)| (c.name, v))
+            .collect();
+        let (q0, qd0) = (q.to_vec(), qd.to_vec());
+        self.assemble(mech, ws, t, q, qd, prescription)?;
+        let changed = |qd: &[f64], (name, v): (&'static str, f64)| {
+            let i = info
+                .coordinate_index(name)
+                .expect("a coordinate of the model");
+            ((qd[i] - v).abs() > 1e-9 * v.abs()).then_some(OverriddenVelocity {
+                coordinate: name,
+                declared: v,
+                used: qd[i],
+            })
+        };
+        let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
+        // The velocities of the last successful assembly.
+        let mut assembled = qd.to_vec();
+        for &d in &declared {
+            if changed(&assembled, d).is_none() {
+                continue;
+            }
+            velocities.push(d);
+            let held = Prescription {
+                coordinates: prescription.coordinates,
+                velocities: &velocities,
+            };
+            q.copy_from_slice(&q0);
+            qd.copy_from_slice(&qd0);
+            if self.assemble(mech, ws, t, q, qd, &held).is_ok() {
+                assembled.copy_from_slice(qd);
+            } else {
+                velocities.pop();
+            }
+        }
+        // The last trial may have failed: assemble once more with what held, which
+        // leaves its partition current.
+        let held = Prescription {
+            coordinates: prescription.coordinates,
+            velocities: &velocities,
+        };
+        q.copy_from_slice(&q0);
+        qd.copy_from_slice(&qd0);
+        let report = self.assemble(mech, ws, t, q, qd, &held)?;
+        let overridden = declared
+            .into_iter()
+            .filter_map(|d| changed(qd, d))
+            .collect();
+        Ok((report, overridden))
     }
 }
 

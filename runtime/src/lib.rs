@@ -41,11 +41,13 @@ mod mechanism;
 pub mod ode;
 mod partition;
 mod reactions;
+mod scale;
 pub mod sim;
 mod workspace;
 
 pub use assembly::{
-    AssemblyError, AssemblyReport, Prescription, StateLevel, Violation, CONSISTENCY_TOLERANCE,
+    AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
+    CONSISTENCY_TOLERANCE,
 };
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,

@@ -10,9 +10,15 @@
 //! constraints) check the returned ratio and fall back to complete pivoting
 //! ([`super::dense::DenseLu`]) below their threshold.
 //!
+//! **Equilibration**, as in [`super::dense`]: the $LU$ scales rows, then columns, the
+//! Cholesky factorization rows and columns alike ($D A D$, keeping the symmetry), by
+//! powers of two to a largest magnitude near 1 (a unit diagonal for Cholesky), and the
+//! solves undo it; the pivot ratios are those of the equilibrated matrix, so they do
+//! not depend on the units of the model.
+//!
 //! Invariant: no allocation after construction.
 
-use super::dense::Pivots;
+use super::dense::{power_of_two_inverse, Pivots};
 
 /// $PA = LU$ with partial (row) pivoting of an `n × n` matrix.
 #[derive(Clone, Debug)]
@@ -20,6 +26,8 @@ pub(crate) struct SmallLu {
     n: usize,
     a: Vec<f64>,
     perm: Vec<usize>,
+    row_scale: Vec<f64>,
+    col_scale: Vec<f64>,
 }
 
 impl SmallLu {
@@ -28,6 +36,8 @@ impl SmallLu {
             n,
             a: vec![0.0; n * n],
             perm: vec![0; n],
+            row_scale: vec![1.0; n],
+            col_scale: vec![1.0; n],
         }
     }
 
@@ -40,10 +50,22 @@ impl SmallLu {
         &mut self.a
     }
 
-    /// Factors in place; returns the pivot magnitudes ($|u_{kk}|$).
+    /// Equilibrates and factors in place; returns the pivot magnitudes ($|u_{kk}|$) of
+    /// the equilibrated matrix.
     pub fn factor(&mut self) -> Pivots {
         let n = self.n;
         let a = &mut self.a;
+        for (row, s) in a.chunks_exact_mut(n.max(1)).zip(&mut self.row_scale) {
+            *s = power_of_two_inverse(row.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+            row.iter_mut().for_each(|x| *x *= *s);
+        }
+        for (j, s) in self.col_scale.iter_mut().enumerate() {
+            let big = (0..n).fold(0.0_f64, |m, i| m.max(a[i * n + j].abs()));
+            *s = power_of_two_inverse(big);
+            for i in 0..n {
+                a[i * n + j] *= *s;
+            }
+        }
         let (mut max, mut min) = (0.0_f64, f64::INFINITY);
         for k in 0..n {
             let mut p = k;
@@ -92,6 +114,10 @@ impl SmallLu {
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.n;
         let a = &self.a;
+        // D_r A D_c (D_c⁻¹ x) = D_r b.
+        for (x, s) in b.iter_mut().zip(&self.row_scale) {
+            *x *= s;
+        }
         for k in 0..n {
             b.swap(k, self.perm[k]);
         }
@@ -111,6 +137,9 @@ impl SmallLu {
                 .sum();
             b[i] = (b[i] - s) / a[i * n + i];
         }
+        for (x, s) in b.iter_mut().zip(&self.col_scale) {
+            *x *= s;
+        }
     }
 }
 
@@ -120,6 +149,7 @@ impl SmallLu {
 pub(crate) struct SmallCholesky {
     n: usize,
     a: Vec<f64>,
+    scale: Vec<f64>,
 }
 
 impl SmallCholesky {
@@ -127,6 +157,7 @@ impl SmallCholesky {
         Self {
             n,
             a: vec![0.0; n * n],
+            scale: vec![1.0; n],
         }
     }
 
@@ -141,6 +172,14 @@ impl SmallCholesky {
     pub fn factor(&mut self) -> Pivots {
         let n = self.n;
         let a = &mut self.a;
+        for (i, s) in self.scale.iter_mut().enumerate() {
+            *s = power_of_two_inverse(a[i * n + i].abs().sqrt());
+        }
+        for i in 0..n {
+            for j in 0..=i {
+                a[i * n + j] *= self.scale[i] * self.scale[j];
+            }
+        }
         let (mut max, mut min) = (0.0_f64, f64::INFINITY);
         for j in 0..n {
             let d = a[j * n + j] - a[j * n..j * n + j].iter().map(|x| x * x).sum::<f64>();
@@ -170,6 +209,10 @@ impl SmallCholesky {
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.n;
         let a = &self.a;
+        // D A D (D⁻¹ x) = D b.
+        for (x, s) in b.iter_mut().zip(&self.scale) {
+            *x *= s;
+        }
         for i in 0..n {
             let s: f64 = a[i * n..i * n + i]
                 .iter()
@@ -181,6 +224,9 @@ impl SmallCholesky {
         for i in (0..n).rev() {
             let s: f64 = (i + 1..n).map(|k| a[k * n + i] * b[k]).sum();
             b[i] = (b[i] - s) / a[i * n + i];
+        }
+        for (x, s) in b.iter_mut().zip(&self.scale) {
+            *x *= s;
         }
     }
 }

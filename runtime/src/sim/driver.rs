@@ -32,8 +32,9 @@ use crate::{
     Preferences, Prescription,
 };
 
-/// Pivot ratio below which constraints are reported as nearly dependent in a failure.
-const NEAR_SINGULAR: f64 = 1e-3;
+/// Pivot ratios below which constraints are reported as nearly dependent in a failure,
+/// tried in turn.
+const NEAR_SINGULAR: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
 /// Most rows an [`Output::Every`] grid may ask for: a finer grid is a mistake (a unit
 /// error) whose rows would not fit in memory; [`Output::Steps`] records every step.
@@ -82,6 +83,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     monitors: Monitors,
     started: Instant,
     y: &'a mut [f64],
+    overridden: Vec<crate::OverriddenVelocity>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -109,21 +111,42 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     }
 
     /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
-    /// below [`NEAR_SINGULAR`]) at the last full state: those that lock the mechanism
-    /// when an iteration stalls on a singular Jacobian with a small residual.
+    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state:
+    /// those that lock the mechanism when an iteration stalls on a singular Jacobian
+    /// with a small residual.
     fn nearly_dependent(&mut self) -> Vec<&'static str> {
         let p = &mut self.sys.point;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
         };
         p.invalidate();
-        let params = PartitionParams {
-            pivot_tolerance: NEAR_SINGULAR,
-            ..PartitionParams::default()
-        };
-        match Partition::compute(p.mech, &mut p.ws, t, &p.q, Preferences::default(), &params) {
-            Err(PartitionError::RedundantHolonomic { constraints, .. }) => constraints,
-            _ => Vec::new(),
+        // The weakest rows first: a stall near a fold (a slider at its reach) leaves a
+        // pivot ratio of a few 1e-3 at the last accepted state.
+        for tolerance in NEAR_SINGULAR {
+            let params = PartitionParams {
+                pivot_tolerance: tolerance,
+                ..PartitionParams::default()
+            };
+            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) =
+                Partition::compute(p.mech, &mut p.ws, t, &p.q, Preferences::default(), &params)
+            {
+                return constraints;
+            }
+        }
+        Vec::new()
+    }
+
+    /// Adds a row at the integrator's last accepted state when the rows end before it
+    /// (output on a grid, or only at the end), so that a partial run ends where the
+    /// integration stopped. Skipped when the state cannot be reconstructed.
+    fn record_last_accepted(&mut self, stepper: &Stepper) {
+        let t = stepper.t();
+        if self.traj.t.last().is_some_and(|&last| last >= t) || self.y.len() != stepper.y().len() {
+            return;
+        }
+        self.y.copy_from_slice(stepper.y());
+        if self.sys.keep(t, self.y).is_ok() {
+            let _ = self.record(t);
         }
     }
 
@@ -131,7 +154,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         let mut stats = Stats {
             newton_iterations: self.sys.point.newton_iterations,
             factorizations: self.sys.point.factorizations,
-            repartitions: self.sys.kin.repartitions() as u64,
+            repartitions: self.sys.point.kin.repartitions() as u64,
             wall_time: self.started.elapsed(),
             ..Stats::default()
         };
@@ -147,10 +170,14 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats,
             monitors: self.monitors,
             redundant_constraints: self.sys.point.redundant.clone(),
+            overridden_velocities: self.overridden.clone(),
         }
     }
 
     fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+        if let Some(s) = stepper {
+            self.record_last_accepted(s);
+        }
         if let SimErrorKind::NewtonFailed { constraints, .. }
         | SimErrorKind::Singular { constraints, .. } = &mut kind
         {
@@ -185,6 +212,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             },
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
+            overridden_velocities: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -231,19 +259,23 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         coordinates: &pq,
         velocities: &pqd,
     };
-    if sim.formulation == Formulation::Unconstrained {
+    let overridden = if sim.formulation == Formulation::Unconstrained {
         // Nothing to enforce, nothing to assemble: the state as given.
         write_prescription(info, t0, &mut q, &mut qd, &prescription)
             .map_err(|e| empty(assembly_error(e)))?;
+        Vec::new()
     } else {
-        sys.kin
-            .assemble(mech, &mut sys.point.ws, t0, &mut q, &mut qd, &prescription)
+        let (_, overridden) = sys
+            .point
+            .kin
+            .assemble_declared(mech, &mut sys.point.ws, t0, &mut q, &mut qd, &prescription)
             .map_err(|e| empty(assembly_error(e)))?;
         sys.point.invalidate();
-    }
+        overridden
+    };
     sys.point.q.copy_from_slice(&q);
     sys.point.qd.copy_from_slice(&qd);
-    sys.point.redundant = sys.fit_rows();
+    sys.point.redundant = sys.point.fit_partition();
     if let Err(e) = sys.accept(t0) {
         return Err(empty(e));
     }
@@ -260,6 +292,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         monitors: Monitors::default(),
         started,
         y: &mut y,
+        overridden,
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -277,7 +310,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
-        h_init: sim.h_init,
+        h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
         h_max,
         max_steps: sim.max_steps,
         dense_output: true,

@@ -16,7 +16,7 @@
 
 use super::chart::{Chart, ChartFailure};
 use super::error::{SimErrorKind, SingularMatrix};
-use super::point::{Point, SINGULAR_RATIO};
+use super::point::{Point, REFIT_RATIO, SINGULAR_RATIO};
 use super::Formulation;
 use crate::linalg::inf_norm;
 use crate::Mechanism;
@@ -25,6 +25,11 @@ use crate::Mechanism;
 /// counts as a branch switch (see [`Partitioned`]), for the evaluations that hardly
 /// move (a correction within the integrator's tolerance never counts either).
 const BRANCH_FLOOR: f64 = 1e-8;
+
+/// Fraction of its value when the rows were chosen below which the pivot ratio of the
+/// chart's $N N^\mathsf{T}$ renews the kept rows of a model with redundant constraints:
+/// the kept rows are turning dependent while the dropped ones could take over.
+const REFIT_FRACTION: f64 = 1e-2;
 
 /// What the driver does with a kept state after [`Form::keep`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,6 +100,9 @@ pub(crate) struct Partitioned {
     chart: Chart,
     /// The last accepted positions.
     accepted: Vec<f64>,
+    /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
+    /// before the first anchor): the reference of [`REFIT_FRACTION`].
+    fit_ratio: f64,
     /// The `(t, y)` whose state is in the point (the last reconstruction), so that the
     /// driver's reconstruction of an accepted state the integrator has just evaluated
     /// costs nothing.
@@ -107,6 +115,7 @@ impl Partitioned {
         Self {
             chart: Chart::new(n, m, mh, rtol, atol),
             accepted: vec![0.0; n],
+            fit_ratio: 0.0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
         }
@@ -127,7 +136,17 @@ impl Form for Partitioned {
             return Ok(());
         }
         p.factorizations += 1;
-        let ratio = self.chart.anchor(p, t).map_err(SimErrorKind::from_eval)?;
+        let eval = SimErrorKind::from_eval;
+        let mut ratio = self.chart.anchor(p, t).map_err(eval)?;
+        let worse =
+            ratio.is_nan() || ratio <= REFIT_RATIO || ratio < REFIT_FRACTION * self.fit_ratio;
+        if worse && p.refit(t) {
+            ratio = self.chart.anchor(p, t).map_err(eval)?;
+            self.fit_ratio = ratio;
+        }
+        if self.fit_ratio == 0.0 {
+            self.fit_ratio = ratio;
+        }
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
                 t,
@@ -161,12 +180,12 @@ impl Form for Partitioned {
                     residual,
                 }) => {
                     p.newton_iterations += iterations as u64;
-                    let bound = p.newton.tolerance * (1.0 + inf_norm(&p.q));
+                    let tol = p.newton.tolerance;
                     return Err(SimErrorKind::NewtonFailed {
                         t,
                         iterations,
                         residual,
-                        constraints: p.violated(bound),
+                        constraints: p.violated(t, tol),
                     });
                 }
             }
@@ -176,7 +195,7 @@ impl Form for Partitioned {
                 correction = correction.max((qj - yj).abs());
             }
             let scale = inf_norm(&p.q);
-            let floor = BRANCH_FLOOR * (1.0 + scale) + self.chart.tolerance(scale);
+            let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
             if correction > moved + floor {
                 return Err(SimErrorKind::NewtonFailed {
                     t,

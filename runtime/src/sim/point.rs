@@ -14,13 +14,21 @@
 
 use super::error::{SimErrorKind, SingularMatrix};
 use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
+use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::inf_norm;
 use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::scale;
 use crate::workspace::{EvalError, Workspace};
 use crate::{Error, Info, Mechanism, NewtonParams};
 
 /// Pivot ratio below which a projection matrix $J J^\mathsf{T}$ counts as singular.
 pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
+
+/// Pivot ratio of a projection matrix (equilibrated $J_R J_R^\mathsf{T}$) below which
+/// the kept rows of a model with redundant constraints are renewed (see
+/// [`Point::refit`]): a ratio of $10^{-8}$ is a condition of $10^4$ for $J_R$, where
+/// Newton starts to stall long before the matrix is singular.
+pub(crate) const REFIT_RATIO: f64 = 1e-8;
 
 /// The point a group of evaluations was made at.
 #[derive(Debug)]
@@ -75,6 +83,8 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     pub info: &'static Info,
     pub ws: Workspace,
     pub dynamics: Dynamics,
+    /// Assembly, Algorithm P and the choice of the independent constraint rows.
+    pub kin: Kinematics,
     /// Newton tolerance of the position projection.
     pub newton: NewtonParams,
     pub q: Vec<f64>,
@@ -109,7 +119,11 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
 }
 
 impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
-    pub fn new(mech: &'a M, dynamics: DynamicsParams, newton: NewtonParams) -> Result<Self, Error> {
+    pub fn new(
+        mech: &'a M,
+        dynamics: DynamicsParams,
+        kin: KinematicsParams,
+    ) -> Result<Self, Error> {
         let info = mech.info();
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
         Ok(Self {
@@ -117,7 +131,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             info,
             ws: Workspace::new(info)?,
             dynamics: Dynamics::new(info, dynamics)?,
-            newton,
+            kin: Kinematics::new(info, kin),
+            newton: kin.newton,
             q: vec![0.0; n],
             qd: vec![0.0; n],
             qdd: vec![0.0; n],
@@ -169,6 +184,49 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.lu_h = SmallCholesky::new(self.rows_h);
             self.lu_v = SmallCholesky::new(self.rows.len());
         }
+    }
+
+    /// Fits the projections to the current partition, which may have dropped redundant
+    /// holonomic constraints; returns the names of the dropped ones.
+    pub fn fit_partition(&mut self) -> Vec<&'static str> {
+        let Some(p) = self.kin.partition() else {
+            return Vec::new();
+        };
+        let info = self.info;
+        let names = p
+            .redundant_rows()
+            .iter()
+            .map(|&i| info.holonomic[i].name)
+            .collect();
+        let rows = p.holonomic_rows().to_vec();
+        self.fit_rows(&rows);
+        names
+    }
+
+    /// Renews the redundant holonomic rows left out of the projections and the chart,
+    /// when there are any: which rows of a dependent set are independent changes along
+    /// the motion (the three pin_y rows of the parallelogram become dependent at the
+    /// bottom of its swing, and a set that dropped a pin_x row turns singular there).
+    /// Returns whether the rows were renewed (the rank of $C_q$ unchanged).
+    pub fn refit(&mut self, t: f64) -> bool {
+        let redundant = self
+            .kin
+            .partition()
+            .is_some_and(|p| !p.redundant_rows().is_empty());
+        if !redundant {
+            return false;
+        }
+        let rank = self.rows_h;
+        let ok = self
+            .kin
+            .repartition(self.mech, &mut self.ws, t, &self.q)
+            .is_ok_and(|p| p.holonomic_rows().len() == rank);
+        // Algorithm P evaluated J into the workspace itself.
+        self.invalidate();
+        if ok {
+            self.fit_partition();
+        }
+        ok
     }
 
     /// $C$ at the current $(t, q)$.
@@ -331,33 +389,46 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let n = self.info.nq();
         let eval = SimErrorKind::from_eval;
+        let tol = self.newton.tolerance;
+        // One renewal of the dropped redundant rows per projection (see `refit`).
+        let mut refitted = false;
         if self.rows_h > 0 {
             let mut iterations = 0;
             loop {
                 let residual = inf_norm(self.constraints(t).map_err(eval)?);
-                let bound = self.newton.tolerance * (1.0 + inf_norm(&self.q));
-                if residual <= bound {
+                self.dense_jacobian(t).map_err(eval)?;
+                let size = scale::coordinate_size(&self.q);
+                if scale::all_met(self.ws.constraints(), self.ws.jacobian(), n, tol, size) {
                     break;
                 }
-                if iterations == self.newton.max_iterations || !residual.is_finite() {
+                let stalled = iterations == self.newton.max_iterations || !residual.is_finite();
+                if stalled && !refitted && self.refit(t) {
+                    (refitted, iterations) = (true, 0);
+                    continue;
+                }
+                if stalled {
                     return Err(SimErrorKind::NewtonFailed {
                         t,
                         iterations,
                         residual,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(t, tol),
                     });
                 }
-                self.dense_jacobian(t).map_err(eval)?;
                 let rows = &self.rows[..self.rows_h];
                 let ratio = gram_cholesky(&mut self.lu_h, self.ws.jacobian(), rows, n);
+                if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
+                    refitted = true;
+                    continue;
+                }
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
                         matrix: SingularMatrix::Projection,
                         ratio,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(t, tol),
                     });
                 }
+                let rows = &self.rows[..self.rows_h];
                 for (mu, &i) in self.mu.iter_mut().zip(rows) {
                     *mu = self.ws.constraints()[i];
                 }
@@ -388,8 +459,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let eval = SimErrorKind::from_eval;
         self.velocity_residuals(t).map_err(eval)?;
         self.dense_jacobian(t).map_err(eval)?;
+        let mut ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        if (ratio.is_nan() || ratio <= REFIT_RATIO) && self.refit(t) {
+            self.velocity_residuals(t).map_err(eval)?;
+            self.dense_jacobian(t).map_err(eval)?;
+            ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        }
         let rows = &self.rows[..];
-        let ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), rows, n);
         self.factorizations += 1;
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
@@ -412,14 +488,22 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// The holonomic constraints whose last evaluated residual exceeds `bound`.
-    pub fn violated(&self, bound: f64) -> Vec<&'static str> {
-        self.ws
-            .constraints()
-            .iter()
-            .zip(self.info.holonomic)
-            .filter(|(c, _)| c.is_nan() || c.abs() > bound)
-            .map(|(_, s)| s.name)
-            .collect()
+    /// The holonomic constraints not met to the relative `tolerance` at the current
+    /// $(t, q)$ (see [`crate::scale`]); empty when they cannot be evaluated.
+    pub fn violated(&mut self, t: f64, tolerance: f64) -> Vec<&'static str> {
+        if self.constraints(t).is_err() || self.dense_jacobian(t).is_err() {
+            return Vec::new();
+        }
+        let size = scale::coordinate_size(&self.q);
+        let n = self.info.nq();
+        scale::unmet(
+            self.ws.constraints(),
+            self.ws.jacobian(),
+            n,
+            tolerance,
+            size,
+        )
+        .map(|i| self.info.holonomic[i].name)
+        .collect()
     }
 }

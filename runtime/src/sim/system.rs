@@ -13,7 +13,7 @@ use super::formulation::{AnyForm, Correction};
 use super::point::Point;
 use super::Formulation;
 use crate::dynamics::DynamicsParams;
-use crate::kinematics::{Kinematics, KinematicsParams};
+use crate::kinematics::KinematicsParams;
 use crate::ode::{OdeSystem, RhsError};
 use crate::{Error, Mechanism, PartitionParams, Preferences};
 
@@ -32,8 +32,6 @@ pub struct Failed;
 pub(crate) struct System<'a, M: Mechanism + ?Sized> {
     pub point: Point<'a, M>,
     pub form: AnyForm,
-    /// Assembly and Algorithm P.
-    pub kin: Kinematics,
     /// Recoverable failures since the last accepted step.
     retries: u32,
     /// The failure of the last evaluation that failed.
@@ -60,29 +58,11 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
         let info = mech.info();
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
         Ok(Self {
-            point: Point::new(mech, dynamics, kin.newton)?,
+            point: Point::new(mech, dynamics, kin)?,
             form: AnyForm::new(formulation, n, m, mh, tolerances),
-            kin: Kinematics::new(info, kin),
             retries: 0,
             failure: None,
         })
-    }
-
-    /// Fits the projections to the partition of the assembly, which may have dropped
-    /// redundant holonomic constraints; returns the names of the dropped ones.
-    pub fn fit_rows(&mut self) -> Vec<&'static str> {
-        let Some(p) = self.kin.partition() else {
-            return Vec::new();
-        };
-        let info = self.point.info;
-        let names = p
-            .redundant_rows()
-            .iter()
-            .map(|&i| info.holonomic[i].name)
-            .collect();
-        let rows = p.holonomic_rows().to_vec();
-        self.point.fit_rows(&rows);
-        names
     }
 
     /// Takes the current full state (consistent, at `t`) as the last accepted one.
@@ -231,14 +211,14 @@ impl<'a, M: Mechanism + ?Sized> StateSpace<'a, M> {
     pub fn start(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), SimErrorKind> {
         let sys = &mut self.0;
         let p = &mut sys.point;
-        sys.kin
+        p.kin
             .repartition_with(p.mech, &mut p.ws, t, q, Preferences::default())
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
         crate::workspace::check_state(p.info, t, q, Some(qd)).map_err(SimErrorKind::from_eval)?;
         p.invalidate();
         p.q.copy_from_slice(q);
         p.qd.copy_from_slice(qd);
-        sys.fit_rows();
+        p.fit_partition();
         sys.accept(t)
     }
 

@@ -6,6 +6,7 @@
 //! test.
 
 mod andrews;
+mod declared;
 mod exact;
 mod faults;
 mod models;
@@ -16,3 +17,4 @@ mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
+mod units;
