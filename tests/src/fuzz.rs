@@ -143,14 +143,13 @@ fn mutate_at(list: &mut Vec<TokenTree>, k: usize, rng: &mut Rng, names: &[String
     // Weighted towards mutations that keep the expression well-formed, so that a good
     // share of the cases reaches the derivation and the emitter.
     match rng.next_u64() % 20 {
-        0..=4 => match &list[k] {
+        0..=4 => {
             // A number where there was one: an extreme value.
-            TokenTree::Literal(_) => {
+            if let TokenTree::Literal(_) = &list[k] {
                 let lit: TokenStream = NUMBERS[pick(rng, NUMBERS.len())].parse().unwrap();
                 list[k] = lit.into_iter().next().unwrap();
             }
-            _ => {}
-        },
+        }
         5..=7 => {
             if let TokenTree::Ident(_) = &list[k] {
                 let name = &names[pick(rng, names.len())];
