@@ -43,16 +43,19 @@ def pendulum_exact(t):
 
 def pendulum_numpy(t, y):
     """Index-1 right-hand side of the pendulum (NumPy)."""
-    m, l, g = PENDULUM["m"], PENDULUM["l"], PENDULUM["g"]
-    del l  # the length enters through the initial state only
+    a, b = pendulum_augmented(y)
+    sol = np.linalg.solve(a, b)
+    return np.concatenate([y[2:], sol[:2]])
+
+
+def pendulum_augmented(y):
+    """The augmented matrix [[M, J^T], [J, 0]] and right-hand side [Q; gamma] of the
+    pendulum at y = [x, y, x', y']: C = x^2 + y^2 - l^2, J = [2x, 2y],
+    gamma = -2 (x'^2 + y'^2)."""
+    m, g = PENDULUM["m"], PENDULUM["g"]
     x, yy, vx, vy = y
-    a = np.zeros((3, 3))
-    a[0, 0] = a[1, 1] = m
-    a[0, 2] = a[2, 0] = 2.0 * x
-    a[1, 2] = a[2, 1] = 2.0 * yy
-    b = np.array([0.0, -m * g, -2.0 * (vx * vx + vy * vy)])
-    s = np.linalg.solve(a, b)
-    return np.array([vx, vy, s[0], s[1]])
+    a = np.array([[m, 0.0, 2.0 * x], [0.0, m, 2.0 * yy], [2.0 * x, 2.0 * yy, 0.0]])
+    return a, np.array([0.0, -m * g, -2.0 * (vx * vx + vy * vy)])
 
 
 def pendulum_casadi(ca):

@@ -41,13 +41,14 @@ PFAFF_DEFAULT = "pfaff partitioning+adams"
 class Model:
     """What the runners need of one model."""
 
-    def __init__(self, name, q0, t_end, exact, numpy_rhs, casadi_parts):
+    def __init__(self, name, q0, t_end, exact, numpy_rhs, augmented, casadi_parts):
         self.name = name
         self.n = len(q0)
         self.y0 = np.concatenate([q0, np.zeros(len(q0))])
         self.t_end = t_end
         self.exact = exact  # the reference positions at t_end
         self.numpy_rhs = numpy_rhs
+        self.augmented = augmented  # y -> (augmented matrix, right-hand side), NumPy
         self.casadi_parts = casadi_parts
 
     def error(self, q):
@@ -79,6 +80,7 @@ MODELS = {
         mo.PENDULUM_T_END,
         mo.pendulum_exact(mo.PENDULUM_T_END),
         mo.pendulum_numpy,
+        mo.pendulum_augmented,
         mo.pendulum_casadi,
     ),
     "andrews": Model(
@@ -87,6 +89,7 @@ MODELS = {
         mo.ANDREWS_T_END,
         mo.ANDREWS_REFERENCE,
         mo.andrews_numpy,
+        mo.andrews_augmented,
         mo.andrews_casadi,
     ),
 }
@@ -180,23 +183,9 @@ class Compiled:
         self.dae = ca.external(dae.name(), self.library)
         self.operations = parts.n_instructions()
         # consistent algebraic state at the start: [a; lambda] from the NumPy model
-        self.z0 = self.algebraic(model, model.y0)
+        a, b = model.augmented(model.y0)
+        self.z0 = np.linalg.solve(a, b)
         self.n = n
-
-    @staticmethod
-    def algebraic(model, y):
-        if model.name == "andrews":
-            a, b = mo.andrews_augmented(y)
-        else:
-            a, b = pendulum_augmented(y)
-        return np.linalg.solve(a, b)
-
-
-def pendulum_augmented(y):
-    m, g = mo.PENDULUM["m"], mo.PENDULUM["g"]
-    x, yy, vx, vy = y
-    a = np.array([[m, 0, 2 * x], [0, m, 2 * yy], [2 * x, 2 * yy, 0]])
-    return a, np.array([0.0, -m * g, -2.0 * (vx * vx + vy * vy)])
 
 
 class CtypesRhs:
