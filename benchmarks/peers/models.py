@@ -43,12 +43,12 @@ def pendulum_exact(t):
 
 def pendulum_numpy(t, y):
     """Index-1 right-hand side of the pendulum (NumPy)."""
-    a, b = pendulum_augmented(y)
+    a, b = pendulum_augmented(y, t)
     sol = np.linalg.solve(a, b)
     return np.concatenate([y[2:], sol[:2]])
 
 
-def pendulum_augmented(y):
+def pendulum_augmented(y, t=0.0):
     """The augmented matrix [[M, J^T], [J, 0]] and right-hand side [Q; gamma] of the
     pendulum at y = [x, y, x', y']: C = x^2 + y^2 - l^2, J = [2x, 2y],
     gamma = -2 (x'^2 + y'^2)."""
@@ -58,8 +58,8 @@ def pendulum_augmented(y):
     return a, np.array([0.0, -m * g, -2.0 * (vx * vx + vy * vy)])
 
 
-def pendulum_casadi(ca):
-    """(q, v, M, Q, C) of the pendulum as CasADi SX."""
+def pendulum_casadi(ca, t):
+    """(q, v, T, Q_e, C) of the pendulum as CasADi SX (`t` unused: autonomous)."""
     m, l, g = PENDULUM["m"], PENDULUM["l"], PENDULUM["g"]
     q = ca.SX.sym("q", 2)
     v = ca.SX.sym("v", 2)
@@ -160,12 +160,12 @@ def andrews_numpy(t, y, p=ANDREWS):
     of Hairer & Wanner II, VII.7 (their f1, f2, f4..f7 are the Coriolis terms of
     T = q'^T M q' / 2, checked in tests/src/accuracy/andrews.rs), J = C_q and gamma by
     hand, and one dense solve of the augmented system."""
-    a, b = andrews_augmented(y, p)
+    a, b = andrews_augmented(y, t, p)
     sol = np.linalg.solve(a, b)
     return np.concatenate([y[7:], sol[:7]])
 
 
-def andrews_augmented(y, p=ANDREWS):
+def andrews_augmented(y, t=0.0, p=ANDREWS):
     """The augmented matrix [[M, J^T], [J, 0]] and right-hand side [f; gamma] of
     `andrews_numpy` at y = [q; v]."""
     q, v = y[:7], y[7:]
@@ -231,10 +231,10 @@ def andrews_augmented(y, p=ANDREWS):
     return a, np.concatenate([f, gamma])
 
 
-def andrews_casadi(ca):
+def andrews_casadi(ca, t):
     """(q, v, T, Q_e, C) of andrews as CasADi SX: the kinetic energy, the applied forces
     (the motor on beta, the spring by its virtual work) and the constraints, from which
-    `index1` derives Q and gamma as pfaff's generator does."""
+    `index1` derives Q and gamma as pfaff's generator does (`t` unused: autonomous)."""
     p = ANDREWS
     q = ca.SX.sym("q", 7)
     v = ca.SX.sym("v", 7)
@@ -252,13 +252,91 @@ def andrews_casadi(ca):
     return q, v, kinetic, applied, c
 
 
-def index1(ca, q, v, kinetic, applied, c):
-    """The index-1 quantities from T, the applied forces and C (no explicit time), as
-    pfaff's generator derives them: M = T_vv, Q = Q_e + T_q - T_vq v,
-    J = C_q, gamma = -(J v)_q v. Returns (M, Q, J, gamma)."""
+# --------------------------------------------------------------------------------------
+# Car axis (Rentrop, Roche & Steinebach 1989), models/src/car_axis.rs
+# --------------------------------------------------------------------------------------
+
+CAR_AXIS = {"eps": 1e-2, "mass": 10.0, "l": 1.0, "l0": 0.5, "r": 0.1, "w": 10.0, "g": 1.0}
+CAR_AXIS_T_END = 3.0
+CAR_AXIS_NAMES = ["xl", "yl", "xr", "yr"]
+CAR_AXIS_Q0 = np.array([0.0, 0.5, 1.0, 0.5])  # (0, l0, l, l0)
+CAR_AXIS_V0 = np.array([-0.5, 0.0, -0.5, 0.0])  # (-l0/l, 0, -l0/l, 0)
+# The reference positions at t = 3 of the "car axis" problem of the Bari test set for IVP
+# solvers (Mazzia & Magherini; computed with GAMD in quadruple precision).
+CAR_AXIS_REFERENCE = np.array([
+    0.493455784275402809122e-1,
+    0.496989460230171153861e0,
+    0.104174252488542151681e1,
+    0.373911027265361256927e0,
+])  # fmt: skip
+
+
+def car_axis_road(t, sin, cos, p=CAR_AXIS):
+    """The road point (x_b, y_b) = (sqrt(l^2 - y_b^2), r sin(w t))."""
+    yb = p["r"] * sin(p["w"] * t)
+    return (p["l"] ** 2 - yb**2) ** 0.5, yb
+
+
+def car_axis_numpy(t, y):
+    """Index-1 right-hand side of the car axis (NumPy)."""
+    a, b = car_axis_augmented(y, t)
+    sol = np.linalg.solve(a, b)
+    return np.concatenate([y[4:], sol[:4]])
+
+
+def car_axis_augmented(y, t, p=CAR_AXIS):
+    """The augmented system of the car axis at time t, y = [q; v]: M = K I with
+    K = mass eps^2 / 2, two springs of unit stiffness and rest length l0, gravity K g;
+    C = (x_b xl + y_b yl, (xl - xr)^2 + (yl - yr)^2 - l^2), rheonomic through the road."""
+    xl, yl, xr, yr, vxl, vyl, vxr, vyr = y
+    k = p["mass"] * p["eps"] ** 2 / 2.0
+    l0, r, w = p["l0"], p["r"], p["w"]
+    xb, yb = car_axis_road(t, math.sin, math.cos)
+    ybd, ybdd = r * w * math.cos(w * t), -r * w * w * math.sin(w * t)
+    xbd = -yb * ybd / xb
+    xbdd = -(ybd**2 + yb * ybdd + xbd**2) / xb
+    left, right = math.hypot(xl, yl), math.hypot(xr - xb, yr - yb)
+    fl, fr = -(left - l0) / left, -(right - l0) / right
+    forces = [fl * xl, fl * yl - k * p["g"], fr * (xr - xb), fr * (yr - yb) - k * p["g"]]
+    dx, dy = xl - xr, yl - yr
+    jac = np.array([[xb, yb, 0.0, 0.0], [2 * dx, 2 * dy, -2 * dx, -2 * dy]])
+    gamma = [
+        -(xbdd * xl + 2 * xbd * vxl + ybdd * yl + 2 * ybd * vyl),
+        -2.0 * ((vxl - vxr) ** 2 + (vyl - vyr) ** 2),
+    ]
+    a = np.zeros((6, 6))
+    a[:4, :4] = k * np.eye(4)
+    a[4:, :4] = jac
+    a[:4, 4:] = jac.T
+    return a, np.concatenate([forces, gamma])
+
+
+def car_axis_casadi(ca, t):
+    """(q, v, T, Q_e, C) of the car axis as CasADi SX: the potential of the springs and
+    of gravity enters as Q_e = -V_q."""
+    p = CAR_AXIS
+    q = ca.SX.sym("q", 4)
+    v = ca.SX.sym("v", 4)
+    xl, yl, xr, yr = (q[i] for i in range(4))
+    k = p["mass"] * p["eps"] ** 2 / 2.0
+    xb, yb = car_axis_road(t, ca.sin, ca.cos)
+    kinetic = 0.5 * k * ca.dot(v, v)
+    left = ca.sqrt(xl**2 + yl**2)
+    right = ca.sqrt((xr - xb) ** 2 + (yr - yb) ** 2)
+    potential = 0.5 * (left - p["l0"]) ** 2 + 0.5 * (right - p["l0"]) ** 2 + k * p["g"] * (yl + yr)
+    c = ca.vertcat(xb * xl + yb * yl, (xl - xr) ** 2 + (yl - yr) ** 2 - p["l"] ** 2)
+    return q, v, kinetic, -ca.gradient(potential, q), c
+
+
+def index1(ca, t, q, v, kinetic, applied, c):
+    """The index-1 quantities from T, the applied forces and C(q, t), as pfaff's
+    generator derives them (math-spec section 4): M = T_vv, Q = Q_e + T_q - T_vq v - T_vt,
+    J = C_q, gamma = -(J v)_q v - 2 J_t v - C_tt. Returns (M, Q, J, gamma)."""
     grad_v = ca.gradient(kinetic, v)
     mass = ca.jacobian(grad_v, v)
-    forces = applied + ca.gradient(kinetic, q) - ca.mtimes(ca.jacobian(grad_v, q), v)
+    forces = applied + ca.gradient(kinetic, q) - ca.mtimes(ca.jacobian(grad_v, q), v) - ca.jacobian(grad_v, t)
     jac = ca.jacobian(c, q)
-    gamma = -ca.mtimes(ca.jacobian(ca.mtimes(jac, v), q), v)
+    jv = ca.mtimes(jac, v)
+    c_t = ca.jacobian(c, t)
+    gamma = -ca.mtimes(ca.jacobian(jv, q), v) - 2 * ca.jacobian(jv, t) - ca.jacobian(c_t, t)
     return mass, forces, jac, gamma

@@ -41,14 +41,14 @@ PFAFF_DEFAULT = "pfaff partitioning+adams"
 class Model:
     """What the runners need of one model."""
 
-    def __init__(self, name, q0, t_end, exact, numpy_rhs, augmented, casadi_parts):
+    def __init__(self, name, q0, v0, t_end, exact, numpy_rhs, augmented, casadi_parts):
         self.name = name
         self.n = len(q0)
-        self.y0 = np.concatenate([q0, np.zeros(len(q0))])
+        self.y0 = np.concatenate([q0, v0])
         self.t_end = t_end
         self.exact = exact  # the reference positions at t_end
         self.numpy_rhs = numpy_rhs
-        self.augmented = augmented  # y -> (augmented matrix, right-hand side), NumPy
+        self.augmented = augmented  # (y, t) -> (augmented matrix, right-hand side), NumPy
         self.casadi_parts = casadi_parts
 
     def error(self, q):
@@ -77,6 +77,7 @@ MODELS = {
     "pendulum": Model(
         "pendulum",
         mo.PENDULUM_Q0,
+        np.zeros(2),
         mo.PENDULUM_T_END,
         mo.pendulum_exact(mo.PENDULUM_T_END),
         mo.pendulum_numpy,
@@ -86,14 +87,25 @@ MODELS = {
     "andrews": Model(
         "andrews",
         mo.ANDREWS_Q0,
+        np.zeros(7),
         mo.ANDREWS_T_END,
         mo.ANDREWS_REFERENCE,
         mo.andrews_numpy,
         mo.andrews_augmented,
         mo.andrews_casadi,
     ),
+    "car_axis": Model(
+        "car_axis",
+        mo.CAR_AXIS_Q0,
+        mo.CAR_AXIS_V0,
+        mo.CAR_AXIS_T_END,
+        mo.CAR_AXIS_REFERENCE,
+        mo.car_axis_numpy,
+        mo.car_axis_augmented,
+        mo.car_axis_casadi,
+    ),
 }
-NAMES = {"pendulum": mo.PENDULUM_NAMES, "andrews": mo.ANDREWS_NAMES}
+NAMES = {"pendulum": mo.PENDULUM_NAMES, "andrews": mo.ANDREWS_NAMES, "car_axis": mo.CAR_AXIS_NAMES}
 
 
 def best_of(run, repeat, budget):
@@ -147,27 +159,31 @@ def pfaff_rows(pfaff, model, tol, repeat, budget):
 
 
 class Compiled:
-    """The generated C of one model: `NAME_ode(y) -> y'` and
-    `NAME_dae(x, z) -> (ode, alg)`, each with its Jacobian, in one shared library."""
+    """The generated C of one model: `NAME_ode(t, y) -> y'` and
+    `NAME_dae(t, x, z) -> (ode, alg)`, each with its Jacobian, in one shared library."""
 
     def __init__(self, ca, model):
-        q, v, kinetic, applied, c = model.casadi_parts(ca)
-        mass, forces, jac, gamma = mo.index1(ca, q, v, kinetic, applied, c)
+        t = ca.SX.sym("t")
+        q, v, kinetic, applied, c = model.casadi_parts(ca, t)
+        mass, forces, jac, gamma = mo.index1(ca, t, q, v, kinetic, applied, c)
         n, m = model.n, jac.shape[0]
         augmented = ca.blockcat([[mass, jac.T], [jac, ca.SX.zeros(m, m)]])
-        parts = ca.Function("parts", [ca.vertcat(q, v)], [augmented, ca.vertcat(forces, gamma)])
+        parts = ca.Function("parts", [t, ca.vertcat(q, v)], [augmented, ca.vertcat(forces, gamma)])
         # The solve of the augmented system: CasADi's sparse LDL^T (generated with the
         # rest). Its symbolic `solve` of SX matrices is no option: it loses about 8
         # digits on andrews.
+        time_mx = ca.MX.sym("t")
         y = ca.MX.sym("y", 2 * n)
-        a_mx, b_mx = parts(y)
-        ode = ca.Function(f"{model.name}_ode", [y], [ca.vertcat(y[n:], ca.solve(a_mx, b_mx, "ldl")[:n])])
+        a_mx, b_mx = parts(time_mx, y)
+        ode = ca.Function(
+            f"{model.name}_ode", [time_mx, y], [ca.vertcat(y[n:], ca.solve(a_mx, b_mx, "ldl")[:n])]
+        )  # fmt: skip
         x = ca.MX.sym("x", 2 * n)
         z = ca.MX.sym("z", n + m)
-        a_x, b_x = parts(x)
+        a_x, b_x = parts(time_mx, x)
         dae = ca.Function(
-            f"{model.name}_dae", [x, z], [ca.vertcat(x[n:], z[:n]), ca.mtimes(a_x, z) - b_x],
-            ["x", "z"], ["ode", "alg"],
+            f"{model.name}_dae", [time_mx, x, z], [ca.vertcat(x[n:], z[:n]), ca.mtimes(a_x, z) - b_x],
+            ["t", "x", "z"], ["ode", "alg"],
         )  # fmt: skip
         os.makedirs(BUILD, exist_ok=True)
         source = f"peers_{model.name}.c"
@@ -183,7 +199,7 @@ class Compiled:
         self.dae = ca.external(dae.name(), self.library)
         self.operations = parts.n_instructions()
         # consistent algebraic state at the start: [a; lambda] from the NumPy model
-        a, b = model.augmented(model.y0)
+        a, b = model.augmented(model.y0, 0.0)
         self.z0 = np.linalg.solve(a, b)
         self.n = n
 
@@ -198,10 +214,11 @@ class CtypesRhs:
         sizes = [size() for _ in range(4)]
         getattr(lib, compiled.symbol + "_work")(*[ctypes.byref(s) for s in sizes])
         n_arg, n_res, n_iw, n_w = (max(1, s.value) for s in sizes)
+        self.t = np.zeros(1)
         self.y = np.zeros(2 * compiled.n)
         self.out = np.zeros(2 * compiled.n)
         dp = ctypes.POINTER(ctypes.c_double)
-        self.arg = (dp * n_arg)(self.y.ctypes.data_as(dp))
+        self.arg = (dp * n_arg)(self.t.ctypes.data_as(dp), self.y.ctypes.data_as(dp))
         self.res = (dp * n_res)(self.out.ctypes.data_as(dp))
         self.iw = (ctypes.c_longlong * n_iw)()
         self.w = (ctypes.c_double * n_w)()
@@ -210,6 +227,7 @@ class CtypesRhs:
         self.args = (self.arg, self.res, self.iw, self.w, 0)
 
     def __call__(self, y, t):
+        self.t[0] = t
         self.y[:] = y
         self.fn(*self.args)
         return self.out.copy()
@@ -218,11 +236,12 @@ class CtypesRhs:
 def sundials_rows(ca, model, compiled, tol, repeat, budget):
     rows = []
     common = {"reltol": tol, "abstol": tol, "max_num_steps": 10**7}
+    t = ca.MX.sym("t")
     x = ca.MX.sym("x", 2 * model.n)
     z = ca.MX.sym("z", compiled.z0.size)
-    ode_problem = {"x": x, "ode": compiled.ode(x)}
-    dae_ode, dae_alg = compiled.dae(x, z)
-    dae_problem = {"x": x, "z": z, "ode": dae_ode, "alg": dae_alg}
+    ode_problem = {"t": t, "x": x, "ode": compiled.ode(t, x)}
+    dae_ode, dae_alg = compiled.dae(t, x, z)
+    dae_problem = {"t": t, "x": x, "z": z, "ode": dae_ode, "alg": dae_alg}
     cases = [
         ("CasADi C + CVODES bdf", "cvodes", ode_problem, {}),
         ("CasADi C + CVODES adams", "cvodes", ode_problem,
@@ -449,7 +468,7 @@ def machine(pfaff):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pfaff", required=True, help="path of the release `pfaff` binary")
-    parser.add_argument("--models", default="pendulum,andrews")
+    parser.add_argument("--models", default="pendulum,andrews,car_axis")
     parser.add_argument("--tols", default=",".join(f"1e-{k}" for k in range(4, 13)))
     parser.add_argument("--repeat", type=int, default=5, help="timed repetitions (best is kept)")
     parser.add_argument("--budget", type=float, default=2.0,
@@ -506,7 +525,7 @@ def main():
         "# pfaff and its peers",
         machine(args.pfaff),
         f"Final position error (largest absolute error of the coordinates at the end: {spans}; "
-        "pendulum against its closed form, andrews against the test-set reference), "
+        "pendulum against its closed form, andrews and car_axis against the test-set references), "
         "right-hand-side evaluations and wall time (best of several runs). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
         "with the fastest pfaff run of this table, any method and tolerance, that is at least as accurate.",
