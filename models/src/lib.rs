@@ -15,6 +15,9 @@
 //! | [`seed2_example1`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
 //! | [`seed2_example2`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
 //! | [`parallelogram`] | `th1 th2 th3 x y phi` | 6 holonomic (one redundant) |
+//! | [`slider_crank_bodies`] | as `slider_crank`, from bodies and joints | 9 holonomic |
+//! | [`sleigh_bodies`] | as `sleigh`, from a body and a knife edge | 1 non-holonomic |
+//! | [`free_body`] | `x y z e0 e1 e2 e3` | 1 holonomic (Euler-parameter normalization) |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -32,6 +35,8 @@
 mod andrews_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
+#[path = "free_body.rs"]
+mod free_body_model;
 #[path = "parallelogram.rs"]
 mod parallelogram_model;
 #[path = "pendulum.rs"]
@@ -40,18 +45,25 @@ mod pendulum_model;
 mod seed2_example1_model;
 #[path = "seed2_example2.rs"]
 mod seed2_example2_model;
+#[path = "sleigh_bodies.rs"]
+mod sleigh_bodies_model;
 #[path = "sleigh.rs"]
 mod sleigh_model;
+#[path = "slider_crank_bodies.rs"]
+mod slider_crank_bodies_model;
 #[path = "slider_crank.rs"]
 mod slider_crank_model;
 
 pub use andrews_model::andrews;
 pub use car_axis_model::car_axis;
+pub use free_body_model::free_body;
 pub use parallelogram_model::parallelogram;
 pub use pendulum_model::pendulum;
 pub use seed2_example1_model::seed2_example1;
 pub use seed2_example2_model::seed2_example2;
+pub use sleigh_bodies_model::sleigh_bodies;
 pub use sleigh_model::sleigh;
+pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
 
 /// A built-in model as listed by the command-line program.
@@ -75,6 +87,21 @@ static ALL: &[Entry] = &[
         name: "slider_crank",
         summary: "planar slider-crank in absolute coordinates, driven crank (math-spec V10)",
         make: || Box::new(slider_crank::Model::default()),
+    },
+    Entry {
+        name: "slider_crank_bodies",
+        summary: "the slider-crank of `slider_crank` from bodies and joints",
+        make: || Box::new(slider_crank_bodies::Model::default()),
+    },
+    Entry {
+        name: "sleigh_bodies",
+        summary: "the Chaplygin sleigh of `sleigh` from a body and a knife edge",
+        make: || Box::new(sleigh_bodies::Model::default()),
+    },
+    Entry {
+        name: "free_body",
+        summary: "torque-free spatial rigid body with Euler parameters (math-spec V12)",
+        make: || Box::new(free_body::Model::default()),
     },
     Entry {
         name: "andrews",

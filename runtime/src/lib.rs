@@ -58,7 +58,10 @@ pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams
 pub use linearize::{
     linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
 };
-pub use mechanism::{Info, Mechanism, Parameter, Pattern, Symbol, TimeDependence};
+pub use mechanism::{
+    Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
+    Parameter, Pattern, Point, Symbol, TimeDependence,
+};
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
 pub use reactions::{
     ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,
@@ -68,5 +71,8 @@ pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Works
 /// Items used by generated code. Not part of the public API.
 #[doc(hidden)]
 pub mod __private {
-    pub use crate::mechanism::{Info, Mechanism, Parameter, Symbol, TimeDependence};
+    pub use crate::mechanism::{
+        Body, Contact, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
+        Parameter, Point, Symbol, TimeDependence,
+    };
 }

@@ -51,7 +51,159 @@ pub struct TimeDependence {
     pub nonholonomic: bool,
 }
 
+/// A reference frame of a body-level model: an origin and an orientation, functions of
+/// `q` and `t`. Its pose is written by [`Mechanism::frame_poses`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frame {
+    /// The name as written in the model.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// The frame it is given relative to (`None`: the ground frame).
+    pub parent: Option<u32>,
+    /// A planar frame: it moves in the global x–y plane and turns about z.
+    pub planar: bool,
+    /// Its orientation is given by Euler parameters, whose normalization is the
+    /// holonomic constraint of this index.
+    pub normalization: Option<u32>,
+}
+
+/// A named point fixed in a frame. Its global position is written by
+/// [`Mechanism::point_positions`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Point {
+    /// The name as written in the model.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// Index of the frame it is fixed in ([`Info::frames`]).
+    pub frame: u32,
+}
+
+/// A rigid body: mass properties attached to a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Body {
+    /// The name as written in the model.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// Index of its frame ([`Info::frames`]).
+    pub frame: u32,
+}
+
+/// What a joint is, as declared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum JointKind {
+    /// Planar revolute joint (2 rows).
+    PlanarRevolute,
+    /// Planar prismatic joint (2 rows).
+    PlanarPrismatic,
+    /// Planar fixed joint (3 rows).
+    PlanarFixed,
+    /// Spherical joint (3 rows).
+    Spherical,
+    /// Spatial revolute joint (5 rows).
+    Revolute,
+    /// Universal (Hooke) joint (4 rows).
+    Universal,
+    /// Cylindrical joint (4 rows).
+    Cylindrical,
+    /// Spatial prismatic joint (5 rows).
+    Prismatic,
+    /// Spatial fixed joint (6 rows).
+    Fixed,
+    /// Distance between two points (1 row).
+    Distance,
+    /// A driver: a coordinate or angle prescribed as a function of time (1 row).
+    Driver,
+    /// No velocity of a point along a direction (1 non-holonomic row); a knife edge.
+    ZeroVelocity,
+    /// A thin wheel rolling without slip on the plane z = 0 (1 holonomic contact row and
+    /// 2 non-holonomic no-slip rows).
+    RollingWheel,
+}
+
+/// A joint: named constraint rows between two frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Joint {
+    /// The name as written in the model; its rows are named `name.suffix`.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// What it is.
+    pub kind: JointKind,
+    /// The two frames it joins (`None`: the ground). The reactions reported for the
+    /// joint act on the first.
+    pub frames: [Option<u32>; 2],
+    /// Its rows among the holonomic constraints: `start..start + len`.
+    pub holonomic: (u32, u32),
+    /// Its rows among the non-holonomic constraints: `start..start + len`.
+    pub nonholonomic: (u32, u32),
+}
+
+/// A contact: a gap function `g(q, t)` that must stay non-negative, with a coefficient
+/// of restitution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Contact {
+    /// The name as written in the model.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// Index of the parameter holding its coefficient of restitution.
+    pub restitution: u32,
+}
+
+/// A named array of model data whose length is fixed by the model but whose values are
+/// known only at run time (for example finite-element invariants read from a file).
+/// Values are read and written with [`Mechanism::data`] and [`Mechanism::set_data`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DataSlot {
+    /// The name as written in the model.
+    pub name: &'static str,
+    /// The doc comment of the declaration (empty when there is none).
+    pub doc: &'static str,
+    /// The number of values.
+    pub len: u32,
+}
+
+/// The values given to [`Mechanism::set_data`] do not fit the slot.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DataError {
+    /// The model has no slot of this index.
+    #[error("model `{model}` has no data slot {index}")]
+    NoSlot {
+        /// The model's name.
+        model: &'static str,
+        /// The index asked for.
+        index: usize,
+    },
+    /// The number of values differs from the slot's length.
+    #[error("data slot `{slot}` holds {expected} values, got {got}")]
+    Length {
+        /// The slot's name.
+        slot: &'static str,
+        /// Its length.
+        expected: usize,
+        /// The number of values given.
+        got: usize,
+    },
+    /// A value is not finite.
+    #[error("data slot `{slot}`: value {index} is {value}")]
+    NotFinite {
+        /// The slot's name.
+        slot: &'static str,
+        /// Position of the value.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
 /// Static description of a model: sizes, names, patterns and structural flags.
+///
+/// Everything a model's generated code is specialised on (sizes, patterns, which
+/// functions exist) is here and is `'static`. Values known only at run time live in the
+/// model itself: parameters, and the arrays of [`Info::data`].
 #[derive(Clone, Copy, Debug)]
 pub struct Info {
     /// The model's name (its module name).
@@ -79,6 +231,54 @@ pub struct Info {
     /// `T + V` is a first integral: no applied forces, no explicit time, and a kinetic
     /// energy that is a quadratic form of the velocities (`T1 = T0 = 0`).
     pub conservative: bool,
+    /// Reference frames of a body-level model, in declaration order.
+    pub frames: &'static [Frame],
+    /// Named points, in declaration order.
+    pub points: &'static [Point],
+    /// Rigid bodies, in declaration order.
+    pub bodies: &'static [Body],
+    /// Joints, in declaration order, with their constraint rows.
+    pub joints: &'static [Joint],
+    /// Named scalar outputs, written by [`Mechanism::outputs`].
+    pub outputs: &'static [Symbol],
+    /// Contacts (gap functions), in row order.
+    pub contacts: &'static [Contact],
+    /// Non-zero entries of the contact normal Jacobian `D = ∂gap/∂q`.
+    pub contact_pattern: Pattern,
+    /// Arrays of run-time model data.
+    pub data: &'static [DataSlot],
+}
+
+impl Info {
+    /// A model with no coordinates and nothing else: the base of hand-written
+    /// descriptions (`Info { name: .., coordinates: .., ..Info::EMPTY }`).
+    pub const EMPTY: Info = Info {
+        name: "",
+        doc: "",
+        coordinates: &[],
+        parameters: &[],
+        holonomic: &[],
+        nonholonomic: &[],
+        mass_pattern: &[],
+        holonomic_pattern: &[],
+        nonholonomic_pattern: &[],
+        time: TimeDependence {
+            mass: false,
+            forces: false,
+            holonomic: false,
+            nonholonomic: false,
+        },
+        nonholonomic_homogeneous: true,
+        conservative: false,
+        frames: &[],
+        points: &[],
+        bodies: &[],
+        joints: &[],
+        outputs: &[],
+        contacts: &[],
+        contact_pattern: &[],
+        data: &[],
+    };
 }
 
 impl Info {
@@ -107,6 +307,45 @@ impl Info {
     pub fn parameter_index(&self, name: &str) -> Option<usize> {
         self.parameters.iter().position(|p| p.name == name)
     }
+    /// Index of the output called `name`.
+    #[must_use]
+    pub fn output_index(&self, name: &str) -> Option<usize> {
+        self.outputs.iter().position(|p| p.name == name)
+    }
+    /// Index of the frame called `name`.
+    #[must_use]
+    pub fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|p| p.name == name)
+    }
+    /// Index of the joint called `name`.
+    #[must_use]
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|p| p.name == name)
+    }
+    /// Number of contacts.
+    #[must_use]
+    pub const fn ncontacts(&self) -> usize {
+        self.contacts.len()
+    }
+}
+
+/// Where [`Mechanism::dynamics_terms`] writes: every quantity the index-1 equations
+/// $[M\ J^\mathsf{T}; J\ 0][\ddot q; \lambda] = [Q; \gamma]$ need at one point, each in
+/// the layout of its own function.
+#[derive(Debug)]
+pub struct DynamicsTerms<'a> {
+    /// Values of [`Info::mass_pattern`].
+    pub mass: &'a mut [f64],
+    /// `Q` (length `n`), as [`Mechanism::forces`].
+    pub forces: &'a mut [f64],
+    /// Values of [`Info::holonomic_pattern`].
+    pub holonomic_jacobian: &'a mut [f64],
+    /// `γ_h` (length `m_h`).
+    pub holonomic_gamma: &'a mut [f64],
+    /// Values of [`Info::nonholonomic_pattern`].
+    pub nonholonomic_matrix: &'a mut [f64],
+    /// `γ_nh` (length `m_nh`).
+    pub nonholonomic_gamma: &'a mut [f64],
 }
 
 /// A mechanism: the functions that `#[pfaff::mechanism]` generates.
@@ -233,5 +472,69 @@ pub trait Mechanism {
     fn potential_energy(&self, t: f64, q: &[f64]) -> f64 {
         let _ = (t, q);
         0.0
+    }
+
+    /// Everything the index-1 equations need at `(t, q, q̇)` in one call, so that the
+    /// generated code computes what the quantities share (the sines of the same angles,
+    /// the same lengths) once. The default calls the separate functions.
+    fn dynamics_terms(&self, t: f64, q: &[f64], qd: &[f64], out: DynamicsTerms<'_>) {
+        self.mass_matrix(t, q, out.mass);
+        self.forces(t, q, qd, out.forces);
+        self.holonomic_jacobian(t, q, out.holonomic_jacobian);
+        self.holonomic_gamma(t, q, qd, out.holonomic_gamma);
+        self.nonholonomic_matrix(t, q, out.nonholonomic_matrix);
+        self.nonholonomic_gamma(t, q, qd, out.nonholonomic_gamma);
+    }
+
+    /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin
+    /// `(x, y, z)` and then the rotation matrix to the global frame, row-major. Planar
+    /// frames have `z = 0` and turn about the z axis.
+    fn frame_poses(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The global positions of the points of [`Info::points`], 3 values per point
+    /// (`z = 0` in planar models).
+    fn point_positions(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The named outputs of [`Info::outputs`].
+    fn outputs(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let _ = (t, q, qd);
+        out.fill(0.0);
+    }
+
+    /// The contact gaps of [`Info::contacts`] (non-negative while open).
+    fn contact_gaps(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The contact normal Jacobian `D = ∂gap/∂q`, as values of [`Info::contact_pattern`].
+    fn contact_jacobian(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The values of data slot `index` ([`Info::data`]).
+    fn data(&self, index: usize) -> &[f64] {
+        let _ = index;
+        &[]
+    }
+
+    /// Replaces the values of data slot `index`.
+    ///
+    /// # Errors
+    /// [`DataError`] when there is no such slot, the length differs from the slot's, or a
+    /// value is not finite.
+    fn set_data(&mut self, index: usize, values: &[f64]) -> Result<(), DataError> {
+        let _ = values;
+        Err(DataError::NoSlot {
+            model: self.info().name,
+            index,
+        })
     }
 }

@@ -86,6 +86,7 @@ fn malformed_patterns_are_rejected() {
         },
         nonholonomic_homogeneous: true,
         conservative: true,
+        ..pfaff::Info::EMPTY
     };
     let err = pfaff::Workspace::new(&BAD).unwrap_err();
     println!("{err}");

@@ -7,6 +7,8 @@ pub mod sources;
 #[cfg(test)]
 mod accuracy;
 #[cfg(test)]
+mod bodies;
+#[cfg(test)]
 mod cli;
 #[cfg(test)]
 mod free_motion;

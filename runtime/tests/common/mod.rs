@@ -99,6 +99,7 @@ pub static SLIDER_CRANK_DRIVEN: Info = Info {
     },
     nonholonomic_homogeneous: true,
     conservative: false,
+    ..Info::EMPTY
 };
 
 pub static SLIDER_CRANK_FREE: Info = Info {
@@ -119,6 +120,7 @@ pub static SLIDER_CRANK_FREE: Info = Info {
     },
     nonholonomic_homogeneous: true,
     conservative: true,
+    ..Info::EMPTY
 };
 
 /// Crank `a`, coupler `b`, masses and inertias of the three bodies.
@@ -281,6 +283,7 @@ pub static SLEIGH: Info = Info {
     },
     nonholonomic_homogeneous: true,
     conservative: true,
+    ..Info::EMPTY
 };
 
 #[derive(Debug, Clone)]
@@ -350,6 +353,7 @@ pub static PENDULUM: Info = Info {
     },
     nonholonomic_homogeneous: true,
     conservative: true,
+    ..Info::EMPTY
 };
 
 pub static PENDULUM_DUPLICATED: Info = Info {
@@ -370,6 +374,7 @@ pub static PENDULUM_DUPLICATED: Info = Info {
     },
     nonholonomic_homogeneous: true,
     conservative: true,
+    ..Info::EMPTY
 };
 
 #[derive(Debug, Clone)]
@@ -473,6 +478,7 @@ impl Chain {
             time: TimeDependence::default(),
             nonholonomic_homogeneous: true,
             conservative: true,
+            ..Info::EMPTY
         }));
         Self {
             n,

@@ -6,6 +6,8 @@ use crate::ctxt::Ctxt;
 use crate::model::expr::{Context, Translator};
 use crate::model::Model;
 use crate::parse::FnItem;
+
+use super::Row;
 use crate::sym::{diff, transform, Deps, ExprId, Graph, Var};
 
 use super::idx;
@@ -207,20 +209,21 @@ pub fn virtual_work(
 }
 
 /// Rejects trivial holonomic constraints. Returns whether the constraint is usable.
-pub fn holonomic(cx: &Ctxt, item: &FnItem, g: &Graph, h: ExprId) -> bool {
+pub fn holonomic(cx: &Ctxt, row: &Row, g: &Graph) -> bool {
+    let h = row.expr;
     if g.is_zero(h) {
-        cx.error_spanned_by(
-            &item.name,
-            format!("holonomic constraint `{}` is identically zero", item.name),
+        cx.error_at(
+            row.span,
+            format!("holonomic constraint `{}` is identically zero", row.name),
         );
         return false;
     }
     if !g.deps(h).has(Deps::Q) {
-        cx.error_spanned_by(
-            &item.name,
+        cx.error_at(
+            row.span,
             format!(
                 "holonomic constraint `{}` does not depend on the coordinates",
-                item.name
+                row.name
             ),
         );
         return false;
@@ -228,9 +231,7 @@ pub fn holonomic(cx: &Ctxt, item: &FnItem, g: &Graph, h: ExprId) -> bool {
     true
 }
 
-/// Reports a non-holonomic constraint whose `G` row still depends on velocities.
-pub fn not_linear(cx: &Ctxt, model: &Model, g: &mut Graph, r: usize, d: ExprId) {
-    let item = &model.nonholonomic[r];
+pub fn not_linear(cx: &Ctxt, model: &Model, g: &mut Graph, row: &Row, d: ExprId) {
     let culprit = (0..model.nq())
         .find(|&k| {
             let dd = diff::differentiate(g, d, Var::Qd(idx(k)));
@@ -238,33 +239,32 @@ pub fn not_linear(cx: &Ctxt, model: &Model, g: &mut Graph, r: usize, d: ExprId) 
         })
         .map(|k| velocity_name(model, k))
         .unwrap_or_default();
-    cx.error_spanned_by(
-        &item.name,
+    cx.error_at(
+        row.span,
         format!(
             "non-holonomic constraint `{}` is not linear in the velocities: `{culprit}` enters non-linearly",
-            item.name
+            row.name
         ),
     );
 }
 
-/// Rejects trivial non-holonomic constraints. Returns whether the constraint is usable.
-pub fn nonholonomic(cx: &Ctxt, item: &FnItem, g: &Graph, nh: ExprId, no_velocity: bool) -> bool {
-    if g.is_zero(nh) {
-        cx.error_spanned_by(
-            &item.name,
+pub fn nonholonomic(cx: &Ctxt, row: &Row, g: &Graph, no_velocity: bool) -> bool {
+    if g.is_zero(row.expr) {
+        cx.error_at(
+            row.span,
             format!(
                 "non-holonomic constraint `{}` is identically zero",
-                item.name
+                row.name
             ),
         );
         return false;
     }
     if no_velocity {
-        cx.error_spanned_by(
-            &item.name,
+        cx.error_at(
+            row.span,
             format!(
                 "non-holonomic constraint `{}` does not depend on the velocities; declare it `#[holonomic]`",
-                item.name
+                row.name
             ),
         );
         return false;

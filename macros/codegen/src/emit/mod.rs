@@ -224,8 +224,11 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         quote!(&[#(#items),*])
     };
     let coordinates = symbols(&mut model.coords.iter().map(|c| (plain(&c.name), &c.docs)));
-    let holonomic = symbols(&mut model.holonomic.iter().map(|c| (plain(&c.name), &c.docs)));
-    let nonholonomic = symbols(&mut model.nonholonomic.iter().map(|c| (plain(&c.name), &c.docs)));
+    let unraw = |n: &String| n.strip_prefix("r#").unwrap_or(n).to_owned();
+    let holonomic = symbols(&mut d.holonomic_names.iter().map(|(n, doc)| (unraw(n), doc)));
+    let nonholonomic = symbols(&mut d.nonholonomic_names.iter().map(|(n, doc)| (unraw(n), doc)));
+    let outputs = symbols(&mut d.outputs.iter().map(|(n, doc, _)| (unraw(n), doc)));
+    let structure = body_level(g, &names, d, &mut TokenStream::new());
     let parameters: Vec<TokenStream> = model
         .params
         .iter()
@@ -248,6 +251,12 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     let conservative = d.conservative;
 
     let mut fns = TokenStream::new();
+    let _ = body_level(g, &names, d, &mut fns);
+    if !d.outputs.is_empty() {
+        let roots: Vec<ExprId> = d.outputs.iter().map(|o| o.2).collect();
+        fns.extend(vector_fn(g, &names, "outputs", &roots, true));
+    }
+    fns.extend(dynamics_terms(g, &names, d));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();
         roots.extend(qd0);
@@ -411,6 +420,11 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 },
                 nonholonomic_homogeneous: #homogeneous,
                 conservative: #conservative,
+                outputs: #outputs,
+                contacts: &[],
+                contact_pattern: &[],
+                data: &[],
+                #structure
             };
 
             #free_motion
@@ -491,6 +505,100 @@ fn free_motion(
     quote! {
         #doc
         pub const FREE_MOTION: &[&str] = &[#(#formulas),*];
+    }
+}
+
+/// The body level's entries of `Info` (returned) and its trait methods `frame_poses` and
+/// `point_positions` (added to `fns`).
+fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream) -> TokenStream {
+    let Some(b) = &d.bodies else {
+        return quote!(frames: &[], points: &[], bodies: &[], joints: &[],);
+    };
+    let opt = |x: Option<u32>| match x {
+        Some(k) => quote!(::core::option::Option::Some(#k)),
+        None => quote!(::core::option::Option::None),
+    };
+    let frames = b.frames.iter().map(|f| {
+        let (n, doc, planar) = (&f.name, &f.docs, f.value.dim == 2);
+        let (p, r) = (opt(f.parent), opt(f.normalization));
+        quote!(::pfaff::__private::Frame { name: #n, doc: #doc, parent: #p, planar: #planar, normalization: #r })
+    });
+    let points = b.points.iter().map(|p| {
+        let (n, doc, f) = (&p.name, &p.docs, p.frame);
+        quote!(::pfaff::__private::Point { name: #n, doc: #doc, frame: #f })
+    });
+    let bodies = b.bodies.iter().map(|p| {
+        let (n, doc, f) = (&p.name, &p.docs, p.frame);
+        quote!(::pfaff::__private::Body { name: #n, doc: #doc, frame: #f })
+    });
+    let joints = b.joints.iter().map(|j| {
+        let (n, doc) = (&j.name, &j.docs);
+        let kind = Ident::new(j.kind, Span::call_site());
+        let (fa, fb) = (opt(j.frames[0]), opt(j.frames[1]));
+        let (h0, h1, n0, n1) = (
+            j.holonomic.0,
+            j.holonomic.1,
+            j.nonholonomic.0,
+            j.nonholonomic.1,
+        );
+        quote!(::pfaff::__private::Joint {
+            name: #n, doc: #doc, kind: ::pfaff::__private::JointKind::#kind,
+            frames: [#fa, #fb], holonomic: (#h0, #h1), nonholonomic: (#n0, #n1),
+        })
+    });
+    if !b.frames.is_empty() {
+        fns.extend(vector_fn(g, names, "frame_poses", &b.poses, false));
+    }
+    if !b.points.is_empty() {
+        fns.extend(vector_fn(
+            g,
+            names,
+            "point_positions",
+            &b.point_roots,
+            false,
+        ));
+    }
+    quote! {
+        frames: &[#(#frames),*],
+        points: &[#(#points),*],
+        bodies: &[#(#bodies),*],
+        joints: &[#(#joints),*],
+    }
+}
+
+/// `dynamics_terms`: `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh` in one schedule, so that what
+/// they share is computed once.
+fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
+    let parts: [(&str, Vec<ExprId>); 6] = [
+        ("mass", entries(&d.mass)),
+        ("forces", d.forces.clone()),
+        ("holonomic_jacobian", entries(&d.cq)),
+        ("holonomic_gamma", d.gamma_h.clone()),
+        ("nonholonomic_matrix", entries(&d.gm)),
+        ("nonholonomic_gamma", d.gamma_nh.clone()),
+    ];
+    let mut roots = Vec::new();
+    let mut slots = Vec::new();
+    for (field, ids) in &parts {
+        for (k, &id) in ids.iter().enumerate() {
+            roots.push(id);
+            slots.push((Ident::new(field, Span::call_site()), k));
+        }
+    }
+    let (code, prog) = body(g, names, &roots, |k, ts| {
+        let (field, i) = &slots[k];
+        let i = Literal::usize_unsuffixed(*i);
+        quote!(out.#field[#i] = #ts;)
+    });
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
+    quote! {
+        fn dynamics_terms(
+            &self, #t: f64, #q: &[f64], #qd: &[f64], out: ::pfaff::__private::DynamicsTerms<'_>,
+        ) {
+            #code
+        }
     }
 }
 

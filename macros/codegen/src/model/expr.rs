@@ -9,6 +9,7 @@
 use quote::ToTokens;
 use syn::spanned::Spanned;
 
+use super::value::{FrameValue, Value};
 use super::Model;
 use crate::ctxt::{suggest, Ctxt};
 use crate::parse::kw;
@@ -29,6 +30,10 @@ pub enum Context {
     Force,
     VirtualWork,
     Definition,
+    /// A frame, point, body or holonomic joint of the body level (no velocities).
+    Kinematics,
+    /// A named output (velocities allowed).
+    Output,
 }
 
 impl Context {
@@ -44,6 +49,8 @@ impl Context {
             Context::Force => "a generalized force",
             Context::VirtualWork => "a virtual work",
             Context::Definition => "a definition",
+            Context::Kinematics => "a frame, point, body or holonomic joint",
+            Context::Output => "an output",
         }
     }
     fn allows_velocity(self) -> bool {
@@ -54,6 +61,7 @@ impl Context {
                 | Context::Force
                 | Context::VirtualWork
                 | Context::Definition
+                | Context::Output
         )
     }
     fn allows_state(self) -> bool {
@@ -64,15 +72,23 @@ impl Context {
 /// Translates the expressions of one model into one graph.
 #[derive(Debug)]
 pub struct Translator<'a> {
-    cx: &'a Ctxt,
+    pub(super) cx: &'a Ctxt,
     model: &'a Model,
     pub g: &'a mut Graph,
     /// Translated definitions, by index; `None` until translated (or on error).
     defs: Vec<Option<ExprId>>,
-    locals: Vec<(String, ExprId)>,
+    locals: Vec<(String, Value)>,
     ctx: Context,
     /// The definition being translated, if any.
     current_def: Option<usize>,
+    /// Names of the model's frames (frames and bodies), in declaration order.
+    pub frame_names: Vec<String>,
+    /// The frames translated so far (a declaration may use the ones above it).
+    pub frames: Vec<FrameValue>,
+    /// Names of the model's named points, in declaration order.
+    pub point_names: Vec<String>,
+    /// Global positions of the points translated so far.
+    pub points: Vec<Vec<ExprId>>,
 }
 
 const METHODS: &[&str] = &[
@@ -92,7 +108,45 @@ impl<'a> Translator<'a> {
             locals: Vec::new(),
             ctx: Context::Definition,
             current_def: None,
+            frame_names: model.frame_names(),
+            frames: Vec::new(),
+            point_names: model.point_names(),
+            points: Vec::new(),
         }
+    }
+
+    /// The local binding `name`, if any (the innermost).
+    pub(super) fn local(&self, name: &str) -> Option<Value> {
+        self.locals
+            .iter()
+            .rev()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+    }
+
+    /// Whether the current context allows velocities.
+    pub(super) fn allows_velocity(&self) -> bool {
+        self.ctx.allows_velocity()
+    }
+
+    /// The current context, for messages.
+    pub(super) fn context_name(&self) -> &'static str {
+        self.ctx.describe()
+    }
+
+    /// The number of coordinates.
+    pub fn nq(&self) -> usize {
+        self.model.nq()
+    }
+
+    /// Translates a value in context `ctx` with no local bindings (a declaration's field).
+    pub fn field_value(&mut self, e: &syn::Expr, ctx: Context) -> Option<Value> {
+        self.with_locals(ctx, &[], |t| t.value(e))
+    }
+
+    /// Translates a scalar field of a declaration in context `ctx`.
+    pub fn field_scalar(&mut self, e: &syn::Expr, ctx: Context) -> Option<ExprId> {
+        self.with_locals(ctx, &[], |t| t.expr(e))
     }
 
     /// Translates the definitions in order; each may use the ones above it.
@@ -220,76 +274,52 @@ impl<'a> Translator<'a> {
                 .error_spanned_by(diverge, "`let .. else` is not supported here");
             return false;
         }
-        match self.expr(&init.expr) {
-            Some(id) => {
-                self.locals.push((ident.to_string(), id));
+        match self.value(&init.expr) {
+            Some(Value::Frame(_)) => {
+                self.cx.error_spanned_by(
+                    &init.expr,
+                    "a `let` binds a number, a vector or a matrix, not a frame",
+                );
+                false
+            }
+            Some(v) => {
+                self.locals.push((ident.to_string(), v));
                 true
             }
             None => false,
         }
     }
 
-    fn expr(&mut self, e: &syn::Expr) -> Option<ExprId> {
-        let id = self.expr_inner(e)?;
-        // Literals are finite, so the first non-finite constant is made by folding here.
-        if let Some(v) = self.g.as_const(id) {
-            if !v.is_finite() {
+    /// Translates `e`, which must be a scalar.
+    pub fn expr(&mut self, e: &syn::Expr) -> Option<ExprId> {
+        let id = match self.value(e)? {
+            Value::Scalar(id) => id,
+            other => {
                 self.cx.error_spanned_by(
                     e,
-                    format!("this expression is constant and evaluates to {v}"),
+                    format!("expected a scalar here; this is {}", other.describe()),
                 );
                 return None;
             }
-        }
+        };
         Some(id)
     }
 
-    fn expr_inner(&mut self, e: &syn::Expr) -> Option<ExprId> {
+    /// A scalar expression that is not a sum, product or negation (those go through
+    /// [`Translator::value`]): a literal, a name, a function call or method.
+    pub(super) fn scalar_leaf(&mut self, e: &syn::Expr) -> Option<ExprId> {
         match e {
             syn::Expr::Lit(l) => self.literal(&l.lit),
-            syn::Expr::Paren(p) => self.expr(&p.expr),
-            syn::Expr::Group(p) => self.expr(&p.expr),
             syn::Expr::Path(p) => self.path(p),
-            syn::Expr::Unary(u) => match u.op {
-                syn::UnOp::Neg(_) => {
-                    let x = self.expr(&u.expr)?;
-                    Some(self.g.neg(x))
-                }
-                _ => {
-                    self.cx.error_spanned_by(
-                        u.op,
-                        format!(
-                            "unsupported operator `{}`, expected `-`",
-                            u.op.to_token_stream()
-                        ),
-                    );
-                    None
-                }
-            },
-            syn::Expr::Binary(b) => {
-                let lhs = self.expr(&b.left);
-                let rhs = self.expr(&b.right);
-                let (lhs, rhs) = (lhs?, rhs?);
-                Some(match b.op {
-                    syn::BinOp::Add(_) => self.g.add(vec![lhs, rhs]),
-                    syn::BinOp::Sub(_) => self.g.sub(lhs, rhs),
-                    syn::BinOp::Mul(_) => self.g.mul(vec![lhs, rhs]),
-                    syn::BinOp::Div(_) if self.g.is_zero(rhs) => {
-                        self.cx.error_spanned_by(&b.right, "division by zero");
-                        return None;
-                    }
-                    syn::BinOp::Div(_) => self.g.div(lhs, rhs),
-                    op => {
-                        self.cx.error_spanned_by(
-                            op,
-                            format!(
-                                "unsupported operator `{}`, expected `+`, `-`, `*` or `/`",
-                                op.to_token_stream()
-                            ),
-                        );
-                        return None;
-                    }
-                })
+            syn::Expr::Unary(u) => {
+                self.cx.error_spanned_by(
+                    u.op,
+                    format!(
+                        "unsupported operator `{}`, expected `-`",
+                        u.op.to_token_stream()
+                    ),
+                );
+                None
             }
             syn::Expr::MethodCall(m) => self.method(m),
             syn::Expr::Call(c) => self.call(c),
@@ -297,11 +327,40 @@ impl<'a> Translator<'a> {
                 self.cx.error_spanned_by(
                     other,
                     "unsupported expression: mechanism expressions use numbers, names, \
-                     `+ - * /`, and the `f64` methods of the function table",
+                     `+ - * /`, vectors `[x, y, z]`, and the `f64` methods of the function table",
                 );
                 None
             }
         }
+    }
+
+    /// `lhs op rhs` for scalars.
+    pub(super) fn scalar_binary(
+        &mut self,
+        b: &syn::ExprBinary,
+        lhs: ExprId,
+        rhs: ExprId,
+    ) -> Option<ExprId> {
+        Some(match b.op {
+            syn::BinOp::Add(_) => self.g.add(vec![lhs, rhs]),
+            syn::BinOp::Sub(_) => self.g.sub(lhs, rhs),
+            syn::BinOp::Mul(_) => self.g.mul(vec![lhs, rhs]),
+            syn::BinOp::Div(_) if self.g.is_zero(rhs) => {
+                self.cx.error_spanned_by(&b.right, "division by zero");
+                return None;
+            }
+            syn::BinOp::Div(_) => self.g.div(lhs, rhs),
+            op => {
+                self.cx.error_spanned_by(
+                    op,
+                    format!(
+                        "unsupported operator `{}`, expected `+`, `-`, `*` or `/`",
+                        op.to_token_stream()
+                    ),
+                );
+                return None;
+            }
+        })
     }
 
     fn literal(&mut self, lit: &syn::Lit) -> Option<ExprId> {
@@ -327,9 +386,9 @@ impl<'a> Translator<'a> {
         }
     }
 
-    fn path(&mut self, p: &syn::ExprPath) -> Option<ExprId> {
+    pub(super) fn path(&mut self, p: &syn::ExprPath) -> Option<ExprId> {
         if let Some(ident) = p.path.get_ident() {
-            return self.name(ident);
+            return self.expr_ident(ident);
         }
         // `std::f64::consts::PI` and friends.
         let segs: Vec<String> = p
@@ -348,10 +407,20 @@ impl<'a> Translator<'a> {
         None
     }
 
-    fn name(&mut self, ident: &syn::Ident) -> Option<ExprId> {
+    /// A scalar named `ident`: a local, coordinate, parameter, `t` or constant.
+    pub(super) fn expr_ident(&mut self, ident: &syn::Ident) -> Option<ExprId> {
         let s = ident.to_string();
-        if let Some(&(_, id)) = self.locals.iter().rev().find(|(n, _)| *n == s) {
-            return Some(id);
+        if let Some(v) = self.local(&s) {
+            return match v {
+                Value::Scalar(id) => Some(id),
+                other => {
+                    self.cx.error_spanned_by(
+                        ident,
+                        format!("`{s}` is {}; a scalar is expected here", other.describe()),
+                    );
+                    None
+                }
+            };
         }
         if let Some(i) = self.model.coord_index(&s) {
             if !self.ctx.allows_state() {
@@ -401,6 +470,8 @@ impl<'a> Translator<'a> {
         }
         let mut names: Vec<String> = self.locals.iter().map(|(n, _)| n.clone()).collect();
         names.extend(self.model.coords.iter().map(|c| c.name.to_string()));
+        names.extend(self.frame_names.iter().cloned());
+        names.extend(self.point_names.iter().cloned());
         names.extend(self.model.params.iter().map(|c| c.name.to_string()));
         names.push(kw::TIME.to_owned());
         names.extend(["PI", "TAU", "E"].map(String::from));
@@ -412,7 +483,7 @@ impl<'a> Translator<'a> {
         None
     }
 
-    fn method(&mut self, m: &syn::ExprMethodCall) -> Option<ExprId> {
+    pub(super) fn method(&mut self, m: &syn::ExprMethodCall) -> Option<ExprId> {
         let name = m.method.to_string();
         if name == kw::DOT {
             return self.velocity(m);
@@ -562,7 +633,7 @@ impl<'a> Translator<'a> {
         Some(self.g.var(Var::Qd(i)))
     }
 
-    fn call(&mut self, c: &syn::ExprCall) -> Option<ExprId> {
+    pub(super) fn call(&mut self, c: &syn::ExprCall) -> Option<ExprId> {
         let syn::Expr::Path(p) = &*c.func else {
             self.cx.error_spanned_by(&c.func, "unsupported call");
             return None;

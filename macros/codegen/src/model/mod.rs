@@ -6,11 +6,12 @@
 //! stay as `syn` trees here; [`expr`] translates them into the symbolic graph.
 
 pub mod expr;
+pub mod value;
 
 use std::collections::HashMap;
 
 use crate::ctxt::{suggest, Ctxt};
-use crate::parse::{self, kw, FnItem, Role};
+use crate::parse::{self, kw, Decl, DeclKind, FnItem, Role};
 
 /// A parameter declaration.
 #[derive(Debug)]
@@ -48,9 +49,34 @@ pub struct Model {
     pub nonholonomic: Vec<FnItem>,
     /// Intermediate definitions, in declaration order.
     pub definitions: Vec<FnItem>,
+    /// `#[output]` functions, in declaration order.
+    pub outputs: Vec<FnItem>,
+    /// Body-level declarations (frames, points, bodies, joints, force elements), in
+    /// declaration order.
+    pub decls: Vec<Decl>,
 }
 
 impl Model {
+    /// Names of the frames: every `Frame` and every `Body` (a body is its frame).
+    pub fn frame_names(&self) -> Vec<String> {
+        self.decls
+            .iter()
+            .filter(|d| matches!(d.kind, DeclKind::Frame | DeclKind::Body))
+            .map(|d| d.name.to_string())
+            .collect()
+    }
+    /// Names of the named points.
+    pub fn point_names(&self) -> Vec<String> {
+        self.decls
+            .iter()
+            .filter(|d| d.kind == DeclKind::Point)
+            .map(|d| d.name.to_string())
+            .collect()
+    }
+    /// Whether the model declares bodies.
+    pub fn has_bodies(&self) -> bool {
+        self.decls.iter().any(|d| d.kind == DeclKind::Body)
+    }
     /// Number of coordinates.
     pub fn nq(&self) -> usize {
         self.coords.len()
@@ -88,6 +114,8 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         holonomic: Vec::new(),
         nonholonomic: Vec::new(),
         definitions: Vec::new(),
+        outputs: Vec::new(),
+        decls: Vec::new(),
     };
     let mut seen: HashMap<String, syn::Ident> = HashMap::new();
     let mut declare = |name: &syn::Ident| {
@@ -130,6 +158,10 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
                     qd0,
                 });
             }
+            parse::Item::Decl(d) => {
+                declare(&d.name);
+                model.decls.push(d);
+            }
             parse::Item::Fn(f) => {
                 if f.name == kw::DELTA {
                     cx.error_spanned_by(
@@ -156,6 +188,10 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
                     }
                     Role::Definition => {
                         model.definitions.push(f);
+                        continue;
+                    }
+                    Role::Output => {
+                        model.outputs.push(f);
                         continue;
                     }
                     Role::Force(_) => {
@@ -196,10 +232,16 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         );
     }
     match (&model.kinetic, &model.mass_matrix) {
+        (_, Some(m)) if model.has_bodies() => cx.error_spanned_by(
+            &m.name,
+            "a model with bodies derives its mass matrix from them; add further kinetic \
+             energy with `fn kinetic_energy`",
+        ),
+        (None, None) if model.has_bodies() => {}
         (None, None) => cx.error_spanned_by(
             &model.ident,
-            "a mechanism needs its kinetic energy: `fn kinetic_energy() -> f64 { .. }` or \
-             `fn mass_matrix() -> [[f64; N]; N] { .. }`",
+            "a mechanism needs its kinetic energy: `fn kinetic_energy() -> f64 { .. }`, \
+             `fn mass_matrix() -> [[f64; N]; N] { .. }` or bodies (`static b: Body = ..;`)",
         ),
         (Some(_), Some(m)) => cx.error_spanned_by(
             &m.name,

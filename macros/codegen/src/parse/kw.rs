@@ -8,6 +8,14 @@ pub const KINETIC_ENERGY: &str = "kinetic_energy";
 pub const POTENTIAL_ENERGY: &str = "potential_energy";
 pub const MASS_MATRIX: &str = "mass_matrix";
 pub const COORDINATE: &str = "Coordinate";
+pub const OUTPUT: &str = "output";
+pub const GROUND: &str = "ground";
+/// The types of `static` declarations of the body level.
+pub const FRAME: &str = "Frame";
+pub const POINT: &str = "Point";
+pub const BODY: &str = "Body";
+pub const JOINT: &str = "Joint";
+pub const FORCE_ELEMENT: &str = "Force";
 pub const Q0: &str = "q0";
 pub const QD0: &str = "qd0";
 pub const DOT: &str = "dot";
@@ -16,7 +24,7 @@ pub const TIME: &str = "t";
 
 /// Names users may not declare: they mean something already. (`delta` stays free for
 /// coordinates — `delta(..)` is a call, so the two never meet — but not for functions.)
-pub const RESERVED: &[&str] = &[TIME, "self", "q", "qd", "out"];
+pub const RESERVED: &[&str] = &[TIME, "self", "q", "qd", "out", GROUND];
 
 /// Mathematical constants usable in expressions.
 pub fn constant(name: &str) -> Option<f64> {

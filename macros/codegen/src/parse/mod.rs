@@ -42,6 +42,28 @@ pub enum Item {
     },
     /// A function item with its role.
     Fn(FnItem),
+    /// `static name: Frame|Point|Body|Joint|Force = <constructor>;`, a declaration of
+    /// the body level.
+    Decl(Decl),
+}
+
+/// What a body-level declaration declares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeclKind {
+    Frame,
+    Point,
+    Body,
+    Joint,
+    Force,
+}
+
+/// A body-level declaration: its kind, name and constructor expression.
+#[derive(Debug)]
+pub struct Decl {
+    pub kind: DeclKind,
+    pub name: syn::Ident,
+    pub docs: String,
+    pub expr: syn::Expr,
 }
 
 /// A function item: an energy, a constraint, a force or a definition.
@@ -67,6 +89,8 @@ pub enum Role {
     VirtualWork,
     /// An intermediate definition, used as `name()`.
     Definition,
+    /// `#[output]`: a named scalar output.
+    Output,
 }
 
 /// Parses the attribute arguments and the module.
@@ -149,15 +173,34 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
         syn::Item::Static(s) => {
             let (docs, attrs) = split_docs(s.attrs);
             reject_attrs(cx, &attrs);
+            if let syn::StaticMutability::Mut(m) = &s.mutability {
+                cx.error_spanned_by(m, "declarations of a mechanism are not `mut`");
+            }
+            let kind = [
+                (kw::FRAME, DeclKind::Frame),
+                (kw::POINT, DeclKind::Point),
+                (kw::BODY, DeclKind::Body),
+                (kw::JOINT, DeclKind::Joint),
+                (kw::FORCE_ELEMENT, DeclKind::Force),
+            ]
+            .into_iter()
+            .find(|(n, _)| is_type(&s.ty, n))
+            .map(|(_, k)| k);
+            if let Some(kind) = kind {
+                return Some(Item::Decl(Decl {
+                    kind,
+                    name: s.ident,
+                    docs,
+                    expr: *s.expr,
+                }));
+            }
             if !is_type(&s.ty, kw::COORDINATE) {
                 cx.error_spanned_by(
                     &s.ty,
-                    "a `static` declares a generalized coordinate and has type `Coordinate`",
+                    "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
+                     a `Point`, a `Body`, a `Joint` or a `Force`",
                 );
                 return None;
-            }
-            if let syn::StaticMutability::Mut(m) = &s.mutability {
-                cx.error_spanned_by(m, "coordinates are not `mut`");
             }
             let (q0, qd0) = parse_coordinate_init(cx, *s.expr);
             Some(Item::Coord {
@@ -281,6 +324,8 @@ fn parse_fn(cx: &Ctxt, f: syn::ItemFn) -> Option<FnItem> {
             Role::Nonholonomic
         } else if path.is_ident(kw::VIRTUAL_WORK) {
             Role::VirtualWork
+        } else if path.is_ident(kw::OUTPUT) {
+            Role::Output
         } else if path.is_ident(kw::FORCE) {
             match attr.parse_args::<syn::Ident>() {
                 Ok(c) => Role::Force(c),
@@ -294,7 +339,7 @@ fn parse_fn(cx: &Ctxt, f: syn::ItemFn) -> Option<FnItem> {
                 attr,
                 format!(
                     "unknown attribute `#[{}]`, expected `#[holonomic]`, `#[nonholonomic]`, \
-                     `#[force(coordinate)]` or `#[virtual_work]`",
+                     `#[force(coordinate)]`, `#[virtual_work]` or `#[output]`",
                     path.to_token_stream()
                 ),
             );

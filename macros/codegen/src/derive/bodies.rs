@@ -1,0 +1,1129 @@
+//! The body level: frames, points, bodies, joints and force elements → the
+//! generalized-coordinate level.
+//!
+//! Input: the model's body-level declarations, in order (each may use the frames and
+//! points above it). Output: [`BodyLevel`], which adds to what the generalized-coordinate
+//! level derives from: the kinetic energy of every body (from the velocity of its centre
+//! of mass and its angular velocity, both derived from the kinematics), the potential of
+//! gravity and springs, the applied generalized forces of force elements (by virtual
+//! power, `Q_i = F·∂v_P/∂q̇_i`), and named constraint rows: joints expand to holonomic
+//! rows, rolling and knife edges to non-holonomic ones, and every frame oriented by Euler
+//! parameters adds its normalization `θᵀθ − 1 = 0`.
+//!
+//! Constructors are struct literals, e.g. `Revolute { a: crank, at_a: [0.0, 0.0], b: ground }`;
+//! an omitted `b` is the ground and an omitted point is the frame's origin.
+
+use std::collections::HashMap;
+
+use proc_macro2::Span;
+use quote::ToTokens;
+use syn::spanned::Spanned;
+
+use super::Row;
+use crate::ctxt::{suggest, Ctxt};
+use crate::model::expr::{Context, Translator};
+use crate::model::value::{
+    add_v, cross, dot, mat_mat, mat_vec, scale_v, sub_v, time_derivative, FrameValue, Value,
+};
+use crate::parse::{Decl, DeclKind};
+use crate::sym::{diff, transform, ExprId, Func, Graph, Var};
+
+/// A frame as exported in `Info`.
+#[derive(Debug)]
+pub struct FrameOut {
+    pub name: String,
+    pub docs: String,
+    pub parent: Option<u32>,
+    pub normalization: Option<u32>,
+    pub value: FrameValue,
+}
+
+/// A named point.
+#[derive(Debug)]
+pub struct PointOut {
+    pub name: String,
+    pub docs: String,
+    pub frame: u32,
+    pub position: Vec<ExprId>,
+}
+
+/// A body: its name and frame.
+#[derive(Debug)]
+pub struct BodyOut {
+    pub name: String,
+    pub docs: String,
+    pub frame: u32,
+}
+
+/// A joint with its rows (indices among the body level's own rows).
+#[derive(Debug)]
+pub struct JointOut {
+    pub name: String,
+    pub docs: String,
+    /// The `pfaff::JointKind` variant.
+    pub kind: &'static str,
+    pub frames: [Option<u32>; 2],
+    pub holonomic: (u32, u32),
+    pub nonholonomic: (u32, u32),
+}
+
+/// What the body level adds to the model.
+#[derive(Debug)]
+pub struct BodyLevel {
+    pub frames: Vec<FrameOut>,
+    pub points: Vec<PointOut>,
+    pub bodies: Vec<BodyOut>,
+    pub joints: Vec<JointOut>,
+    pub holonomic: Vec<Row>,
+    pub nonholonomic: Vec<Row>,
+    pub kinetic: ExprId,
+    pub potential: ExprId,
+    /// Applied generalized forces of force elements, length `n`.
+    pub applied: Vec<ExprId>,
+    /// Whether a force element applies a non-potential force.
+    pub has_applied: bool,
+    /// Per frame, the origin (3) and the rotation matrix (3×3, row-major); planar frames
+    /// embedded in the x–y plane.
+    pub poses: Vec<ExprId>,
+    /// Per point, its global position (3; `z = 0` in planar models).
+    pub point_roots: Vec<ExprId>,
+}
+
+fn idx(i: usize) -> u32 {
+    u32::try_from(i).expect("model size fits u32")
+}
+
+/// The fields of a constructor `Name { field: expr, .. }`.
+struct Fields<'a> {
+    kind: String,
+    span: Span,
+    map: HashMap<String, &'a syn::Expr>,
+}
+
+impl<'a> Fields<'a> {
+    fn get(&self, name: &str) -> Option<&'a syn::Expr> {
+        self.map.get(name).copied()
+    }
+}
+
+fn fields<'a>(
+    cx: &Ctxt,
+    e: &'a syn::Expr,
+    kinds: &[(&str, &[&str], &[&str])],
+    what: &str,
+) -> Option<Fields<'a>> {
+    let syn::Expr::Struct(s) = e else {
+        let names: Vec<String> = kinds
+            .iter()
+            .map(|k| format!("`{} {{ .. }}`", k.0))
+            .collect();
+        cx.error_spanned_by(e, format!("expected {what}: {}", names.join(", ")));
+        return None;
+    };
+    let kind = s
+        .path
+        .segments
+        .last()
+        .map(|x| x.ident.to_string())
+        .unwrap_or_default();
+    let Some(&(_, required, optional)) = kinds.iter().find(|k| k.0 == kind) else {
+        let hint = suggest(&kind, kinds.iter().map(|k| k.0))
+            .map(|n| format!("; did you mean `{n}`?"))
+            .unwrap_or_default();
+        let names: Vec<String> = kinds.iter().map(|k| format!("`{}`", k.0)).collect();
+        cx.error_spanned_by(
+            &s.path,
+            format!(
+                "unknown {what} `{kind}`, expected one of {}{hint}",
+                names.join(", ")
+            ),
+        );
+        return None;
+    };
+    if let Some(rest) = &s.rest {
+        cx.error_spanned_by(rest, "`..` is not needed: optional fields have defaults");
+    }
+    let mut map = HashMap::new();
+    let mut ok = true;
+    for f in &s.fields {
+        let name = match &f.member {
+            syn::Member::Named(i) => i.to_string(),
+            syn::Member::Unnamed(_) => String::new(),
+        };
+        if !required.contains(&name.as_str()) && !optional.contains(&name.as_str()) {
+            let all = required.iter().chain(optional.iter()).copied();
+            let hint = suggest(&name, all)
+                .map(|n| format!("; did you mean `{n}`?"))
+                .unwrap_or_default();
+            let list: Vec<String> = required
+                .iter()
+                .chain(optional.iter())
+                .map(|n| format!("`{n}`"))
+                .collect();
+            cx.error_spanned_by(
+                &f.member,
+                format!(
+                    "`{kind}` has no field `{name}` (its fields: {}){hint}",
+                    list.join(", ")
+                ),
+            );
+            ok = false;
+            continue;
+        }
+        if map.insert(name.clone(), &f.expr).is_some() {
+            cx.error_spanned_by(&f.member, format!("duplicate field `{name}`"));
+            ok = false;
+        }
+    }
+    for r in required {
+        if !map.contains_key(*r) {
+            cx.error_spanned_by(&s.path, format!("`{kind}` needs the field `{r}`"));
+            ok = false;
+        }
+    }
+    ok.then_some(Fields {
+        kind,
+        span: s.path.span(),
+        map,
+    })
+}
+
+const FRAME_KINDS: &[(&str, &[&str], &[&str])] =
+    &[("Frame", &["origin"], &["parent", "angle", "rotation"])];
+const POINT_KINDS: &[(&str, &[&str], &[&str])] = &[("Point", &["frame"], &["at"])];
+const BODY_KINDS: &[(&str, &[&str], &[&str])] = &[(
+    "Body",
+    &["mass"],
+    &[
+        "frame", "parent", "origin", "angle", "rotation", "inertia", "com",
+    ],
+)];
+const JOINT_KINDS: &[(&str, &[&str], &[&str])] = &[
+    (
+        "Revolute",
+        &["a"],
+        &["at_a", "b", "at_b", "axis_a", "axis_b"],
+    ),
+    ("Spherical", &["a"], &["at_a", "b", "at_b"]),
+    (
+        "Universal",
+        &["a", "axis_a", "axis_b"],
+        &["at_a", "b", "at_b"],
+    ),
+    (
+        "Cylindrical",
+        &["a", "axis_a", "axis_b"],
+        &["at_a", "b", "at_b"],
+    ),
+    (
+        "Prismatic",
+        &["a", "axis_a"],
+        &["at_a", "b", "at_b", "axis_b", "angle"],
+    ),
+    ("Fixed", &["a"], &["at_a", "b", "at_b", "angle"]),
+    ("Distance", &["a", "length"], &["at_a", "b", "at_b"]),
+    ("Driver", &["value", "motion"], &[]),
+    ("ZeroVelocity", &["a", "along"], &["at_a"]),
+    ("KnifeEdge", &["a", "lateral"], &["at_a"]),
+    ("RollingWheel", &["a", "axis", "radius"], &["center", "up"]),
+];
+const FORCE_KINDS: &[(&str, &[&str], &[&str])] = &[
+    ("Gravity", &["acceleration"], &[]),
+    (
+        "SpringDamper",
+        &["a", "stiffness", "rest_length"],
+        &["at_a", "b", "at_b", "damping"],
+    ),
+    ("PointForce", &["a", "force"], &["at_a"]),
+    ("Torque", &["a", "torque"], &[]),
+];
+
+struct Builder<'t, 'a> {
+    cx: &'a Ctxt,
+    tr: &'t mut Translator<'a>,
+    defaults: Vec<f64>,
+    out: BodyLevel,
+    kinetic: Vec<ExprId>,
+    potential: Vec<ExprId>,
+    /// `(mass, centre of mass)` of each body, for gravity.
+    masses: Vec<(ExprId, Vec<ExprId>)>,
+    gravity: Option<(Vec<ExprId>, Span)>,
+}
+
+/// Expands the body-level declarations of the model translated by `tr`.
+pub fn expand<'a>(
+    cx: &'a Ctxt,
+    tr: &mut Translator<'a>,
+    decls: &[Decl],
+    defaults: &[f64],
+) -> Option<BodyLevel> {
+    let zero = tr.g.constant(0.0);
+    let n = tr.nq();
+    let mut b = Builder {
+        cx,
+        tr,
+        defaults: defaults.to_vec(),
+        out: BodyLevel {
+            frames: Vec::new(),
+            points: Vec::new(),
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            holonomic: Vec::new(),
+            nonholonomic: Vec::new(),
+            kinetic: zero,
+            potential: zero,
+            applied: vec![zero; n],
+            has_applied: false,
+            poses: Vec::new(),
+            point_roots: Vec::new(),
+        },
+        kinetic: Vec::new(),
+        potential: Vec::new(),
+        masses: Vec::new(),
+        gravity: None,
+    };
+    let mut ok = true;
+    for d in decls {
+        let done = match d.kind {
+            DeclKind::Frame => b.frame(d, None),
+            DeclKind::Body => b.body(d),
+            DeclKind::Point => b.point(d),
+            DeclKind::Joint => b.joint(d),
+            DeclKind::Force => b.force(d),
+        };
+        ok &= done.is_some();
+        if done.is_none() && matches!(d.kind, DeclKind::Frame | DeclKind::Body) {
+            // Keep indices aligned so later declarations resolve (their errors would be
+            // consequences of this one).
+            return None;
+        }
+    }
+    if let Some((gv, span)) = b.gravity.clone() {
+        if b.masses.is_empty() {
+            cx.error_at(span, "gravity acts on bodies, and the model declares none");
+            ok = false;
+        }
+        let dim = gv.len();
+        for (m, r) in b.masses.clone() {
+            if r.len() != dim {
+                cx.error_at(
+                    span,
+                    format!(
+                        "gravity is a {dim}-vector but the bodies are {}-dimensional",
+                        r.len()
+                    ),
+                );
+                return None;
+            }
+            let w = dot(b.tr.g, &gv, &r);
+            let mw = b.tr.g.mul(vec![m, w]);
+            b.potential.push(b.tr.g.neg(mw));
+        }
+    }
+    if !ok {
+        return None;
+    }
+    let g = &mut *b.tr.g;
+    let (one, zero) = (g.constant(1.0), g.constant(0.0));
+    for f in &b.out.frames {
+        let v = &f.value;
+        if v.dim == 2 {
+            let r = &v.rotation;
+            b.out.poses.extend([v.origin[0], v.origin[1], zero]);
+            b.out
+                .poses
+                .extend([r[0], r[1], zero, r[2], r[3], zero, zero, zero, one]);
+        } else {
+            b.out.poses.extend(v.origin.iter().copied());
+            b.out.poses.extend(v.rotation.iter().copied());
+        }
+    }
+    for p in &b.out.points {
+        b.out.point_roots.extend(p.position.iter().copied());
+        if p.position.len() == 2 {
+            b.out.point_roots.push(zero);
+        }
+    }
+    b.out.kinetic = g.add(std::mem::take(&mut b.kinetic));
+    b.out.potential = g.add(std::mem::take(&mut b.potential));
+    Some(b.out)
+}
+
+impl<'a> Builder<'_, 'a> {
+    fn g(&mut self) -> &mut Graph {
+        self.tr.g
+    }
+
+    fn scalar(&mut self, e: &syn::Expr, ctx: Context) -> Option<ExprId> {
+        self.tr.field_scalar(e, ctx)
+    }
+
+    fn vector(&mut self, e: &syn::Expr, dim: usize, ctx: Context) -> Option<Vec<ExprId>> {
+        match self.tr.field_value(e, ctx)? {
+            Value::Vector(v) if v.len() == dim => Some(v),
+            other => {
+                self.cx.error_spanned_by(
+                    e,
+                    format!("expected a {dim}-vector; this is {}", other.describe()),
+                );
+                None
+            }
+        }
+    }
+
+    fn frame_of(&mut self, e: &syn::Expr) -> Option<Option<usize>> {
+        match self.tr.field_value(e, Context::Kinematics)? {
+            Value::Frame(f) => Some(f),
+            other => {
+                self.cx.error_spanned_by(
+                    e,
+                    format!(
+                        "expected a frame or body name (or `ground`); this is {}",
+                        other.describe()
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    fn dim_of(&self, f: Option<usize>) -> usize {
+        f.map_or_else(|| self.tr.model_dim(), |k| self.tr.frames[k].dim)
+    }
+
+    /// An optional point field in frame coordinates (the origin when omitted).
+    fn at(&mut self, fl: &Fields<'_>, name: &str, dim: usize) -> Option<Vec<ExprId>> {
+        match fl.get(name) {
+            Some(e) => self.vector(e, dim, Context::Kinematics),
+            None => Some(vec![self.g().constant(0.0); dim]),
+        }
+    }
+
+    /// Defines frame `d.name` from the fields `fl` (of a `Frame` or an inline `Body`).
+    fn define_frame(&mut self, d: &Decl, fl: &Fields<'_>) -> Option<usize> {
+        let parent = match fl.get("parent") {
+            Some(p) => self.frame_of(p)?,
+            None => None,
+        };
+        let origin_e = fl.get("origin")?;
+        let origin = match self.tr.field_value(origin_e, Context::Kinematics)? {
+            Value::Vector(v) => v,
+            other => {
+                self.cx.error_spanned_by(
+                    origin_e,
+                    format!(
+                        "the origin is a 2-vector (planar) or a 3-vector (spatial); this is {}",
+                        other.describe()
+                    ),
+                );
+                return None;
+            }
+        };
+        let dim = origin.len();
+        if let Some(p) = parent {
+            if self.tr.frames[p].dim != dim {
+                self.cx
+                    .error_spanned_by(origin_e, "a frame has the dimension of its parent");
+                return None;
+            }
+        }
+        if let Some(first) = self.tr.frames.first() {
+            if first.dim != dim {
+                self.cx.error_spanned_by(
+                    origin_e,
+                    format!("the model's frames are {}-dimensional; planar and spatial frames do not mix", first.dim),
+                );
+                return None;
+            }
+        }
+        let pv = self.tr.frame_value(parent, dim);
+        let mut euler = None;
+        let mut normalization = None;
+        let (rel_rotation, rel_angle) = if dim == 2 {
+            if fl.get("rotation").is_some() {
+                self.cx.error_at(
+                    fl.span,
+                    "a planar frame is oriented by `angle`, not `rotation`",
+                );
+                return None;
+            }
+            let Some(a) = fl.get("angle") else {
+                self.cx.error_at(
+                    fl.span,
+                    "a planar frame needs `angle` (use `angle: 0.0` for a translating frame)",
+                );
+                return None;
+            };
+            let a = self.scalar(a, Context::Kinematics)?;
+            (crate::model::value::rot2(self.g(), a), Some(a))
+        } else {
+            if fl.get("angle").is_some() {
+                self.cx.error_at(
+                    fl.span,
+                    "a spatial frame is oriented by `rotation`, not `angle`",
+                );
+                return None;
+            }
+            let Some(r) = fl.get("rotation") else {
+                self.cx.error_at(fl.span, "a spatial frame needs `rotation` (e.g. `euler_parameters(e0, e1, e2, e3)` or `rot_z(psi) * rot_x(phi)`)");
+                return None;
+            };
+            if let syn::Expr::Call(c) = r {
+                if matches!(&*c.func, syn::Expr::Path(p) if p.path.is_ident("euler_parameters"))
+                    && c.args.len() == 4
+                {
+                    let mut e = Vec::new();
+                    for a in &c.args {
+                        e.push(self.scalar(a, Context::Kinematics)?);
+                    }
+                    let e = [e[0], e[1], e[2], e[3]];
+                    if parent.is_none() {
+                        euler = Some(e);
+                    }
+                    let sq = dot(self.g(), &e, &e);
+                    let one = self.g().constant(1.0);
+                    let c = self.g().sub(sq, one);
+                    normalization = Some(idx(self.out.holonomic.len()));
+                    self.out.holonomic.push(Row {
+                        name: format!("{}.normalization", d.name),
+                        docs: format!("Euler-parameter normalization θᵀθ − 1 = 0 of `{}`.", d.name),
+                        span: d.name.span(),
+                        expr: c,
+                    });
+                }
+            }
+            match self.tr.field_value(r, Context::Kinematics)? {
+                Value::Matrix(3, m) => (m, None),
+                other => {
+                    self.cx.error_spanned_by(
+                        r,
+                        format!("a rotation is a 3×3 matrix; this is {}", other.describe()),
+                    );
+                    return None;
+                }
+            }
+        };
+        let po = mat_vec(self.g(), dim, &pv.rotation, &origin);
+        let origin = add_v(self.g(), &pv.origin, &po);
+        let rotation = if parent.is_some() {
+            mat_mat(self.g(), dim, &pv.rotation, &rel_rotation)
+        } else {
+            rel_rotation
+        };
+        let angle = match (rel_angle, pv.angle) {
+            (Some(a), Some(p)) if parent.is_some() => Some(self.g().add(vec![a, p])),
+            (Some(a), _) => Some(a),
+            _ => None,
+        };
+        let value = FrameValue {
+            dim,
+            origin,
+            rotation: if dim == 2 {
+                match angle {
+                    Some(a) if parent.is_some() => crate::model::value::rot2(self.g(), a),
+                    _ => rotation,
+                }
+            } else {
+                rotation
+            },
+            angle,
+            euler,
+        };
+        self.tr.frames.push(value.clone());
+        self.out.frames.push(FrameOut {
+            name: d.name.to_string(),
+            docs: d.docs.clone(),
+            parent: parent.map(idx),
+            normalization,
+            value,
+        });
+        Some(self.tr.frames.len() - 1)
+    }
+
+    fn frame(&mut self, d: &Decl, _: Option<()>) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, FRAME_KINDS, "frame")?;
+        self.define_frame(d, &fl).map(|_| ())
+    }
+
+    fn body(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, BODY_KINDS, "body")?;
+        let k = if let Some(f) = fl.get("frame") {
+            for other in ["parent", "origin", "angle", "rotation"] {
+                if let Some(e) = fl.get(other) {
+                    self.cx
+                        .error_spanned_by(e, format!("a body given a `frame` takes no `{other}`"));
+                    return None;
+                }
+            }
+            let Some(src) = self.frame_of(f)? else {
+                self.cx
+                    .error_spanned_by(f, "a body moves: its frame is not the ground");
+                return None;
+            };
+            let value = self.tr.frames[src].clone();
+            self.tr.frames.push(value.clone());
+            self.out.frames.push(FrameOut {
+                name: d.name.to_string(),
+                docs: d.docs.clone(),
+                parent: self.out.frames[src].parent,
+                normalization: self.out.frames[src].normalization,
+                value,
+            });
+            self.tr.frames.len() - 1
+        } else {
+            if fl.get("origin").is_none() {
+                self.cx.error_at(fl.span, "a body needs its frame: `frame: f`, or `origin` with `angle` (planar) or `rotation` (spatial)");
+                return None;
+            }
+            self.define_frame(d, &fl)?
+        };
+        let fv = self.tr.frames[k].clone();
+        let dim = fv.dim;
+        let nq = self.tr.nq();
+        let mass = self.scalar(fl.get("mass")?, Context::Kinematics)?;
+        let com = self.at(&fl, "com", dim)?;
+        let rc = fv.point(self.g(), &com);
+        let vc: Vec<ExprId> = rc
+            .iter()
+            .map(|&x| time_derivative(self.g(), nq, x))
+            .collect();
+        let vv = dot(self.g(), &vc, &vc);
+        let half = self.g().constant(0.5);
+        let mut terms = vec![self.g().mul(vec![half, mass, vv])];
+        if let Some(ie) = fl.get("inertia") {
+            if dim == 2 {
+                let i = self.scalar(ie, Context::Kinematics)?;
+                let Value::Scalar(w) = fv.angular_velocity(self.g(), nq) else {
+                    unreachable!("planar frames have a scalar rate")
+                };
+                terms.push(self.g().mul(vec![half, i, w, w]));
+            } else {
+                let inertia = match self.tr.field_value(ie, Context::Kinematics)? {
+                    Value::Matrix(3, m) => m,
+                    Value::Vector(v) if v.len() == 3 => {
+                        let z = self.g().constant(0.0);
+                        vec![v[0], z, z, z, v[1], z, z, z, v[2]]
+                    }
+                    other => {
+                        self.cx.error_spanned_by(ie, format!("the inertia of a spatial body is a 3×3 matrix (or the 3-vector of its diagonal); this is {}", other.describe()));
+                        return None;
+                    }
+                };
+                for i in 0..3 {
+                    for j in 0..i {
+                        let (a, b) = (inertia[3 * i + j], inertia[3 * j + i]);
+                        let diff = self.g().sub(a, b);
+                        if !self.g().is_zero(diff) {
+                            self.cx.error_spanned_by(ie, format!("the inertia tensor is not symmetric: entries ({i}, {j}) and ({j}, {i}) differ"));
+                            return None;
+                        }
+                    }
+                }
+                let w = fv.body_angular_velocity(self.g(), nq);
+                let iw = mat_vec(self.g(), 3, &inertia, &w);
+                let wiw = dot(self.g(), &w, &iw);
+                terms.push(self.g().mul(vec![half, wiw]));
+            }
+        }
+        let t = self.g().add(terms);
+        self.kinetic.push(t);
+        self.masses.push((mass, rc));
+        self.out.bodies.push(BodyOut {
+            name: d.name.to_string(),
+            docs: d.docs.clone(),
+            frame: idx(k),
+        });
+        Some(())
+    }
+
+    fn point(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, POINT_KINDS, "point")?;
+        let f = self.frame_of(fl.get("frame")?)?;
+        let dim = self.dim_of(f);
+        let u = self.at(&fl, "at", dim)?;
+        let fv = self.tr.frame_value(f, dim);
+        let p = fv.point(self.g(), &u);
+        self.tr.points.push(p.clone());
+        let Some(frame) = f else {
+            self.cx.error_spanned_by(
+                &d.name,
+                "a named point is fixed in a moving frame; a ground point is a constant vector",
+            );
+            return None;
+        };
+        self.out.points.push(PointOut {
+            name: d.name.to_string(),
+            docs: d.docs.clone(),
+            frame: idx(frame),
+            position: p,
+        });
+        Some(())
+    }
+
+    /// A unit vector along the constant `axis` and two unit vectors completing it to a
+    /// right-handed orthonormal basis.
+    fn basis(
+        &mut self,
+        e: &syn::Expr,
+        axis: &[ExprId],
+    ) -> Option<(Vec<ExprId>, Vec<ExprId>, Vec<ExprId>)> {
+        let defaults = &self.defaults;
+        let values = transform::eval(self.tr.g, axis, &|v| match v {
+            Var::Param(i) => defaults.get(i as usize).copied().unwrap_or(f64::NAN),
+            _ => f64::NAN,
+        });
+        if values.iter().any(|v| !v.is_finite()) {
+            self.cx.error_spanned_by(
+                e,
+                "an axis is constant: it may use numbers and parameters, not coordinates or time",
+            );
+            return None;
+        }
+        let len = values.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if len == 0.0 || !len.is_normal() {
+            self.cx.error_spanned_by(e, "this axis has zero length");
+            return None;
+        }
+        let sq = dot(self.g(), axis, axis);
+        let norm = self.g().call(Func::Sqrt, sq);
+        let one = self.g().constant(1.0);
+        let inv = self.g().div(one, norm);
+        let u = scale_v(self.g(), inv, axis);
+        if axis.len() == 2 {
+            let nu = self.g().neg(u[1]);
+            let p = vec![nu, u[0]];
+            return Some((u, p.clone(), p));
+        }
+        // The coordinate axis least aligned with `axis` (at the parameters' defaults).
+        let k = (0..3)
+            .min_by(|&i, &j| values[i].abs().total_cmp(&values[j].abs()))
+            .expect("three components");
+        let (o, z) = (self.g().constant(1.0), self.g().constant(0.0));
+        let ek: Vec<ExprId> = (0..3).map(|i| if i == k { o } else { z }).collect();
+        let c = cross(self.g(), &u, &ek);
+        let csq = dot(self.g(), &c, &c);
+        let cn = self.g().call(Func::Sqrt, csq);
+        let cinv = self.g().div(o, cn);
+        let p1 = scale_v(self.g(), cinv, &c);
+        let p2 = cross(self.g(), &u, &p1);
+        Some((u, p1, p2))
+    }
+
+    fn push_rows(&mut self, d: &Decl, rows: Vec<(&str, ExprId)>, nonholonomic: bool) -> (u32, u32) {
+        let list = if nonholonomic {
+            &mut self.out.nonholonomic
+        } else {
+            &mut self.out.holonomic
+        };
+        let start = idx(list.len());
+        for (suffix, expr) in &rows {
+            list.push(Row {
+                name: if suffix.is_empty() {
+                    d.name.to_string()
+                } else {
+                    format!("{}.{suffix}", d.name)
+                },
+                docs: d.docs.clone(),
+                span: d.name.span(),
+                expr: *expr,
+            });
+        }
+        (start, idx(rows.len()))
+    }
+
+    fn joint(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, JOINT_KINDS, "joint")?;
+        let kind = fl.kind.clone();
+        if kind == "Driver" {
+            let v = self.scalar(fl.get("value")?, Context::Kinematics)?;
+            let m = self.scalar(fl.get("motion")?, Context::Kinematics)?;
+            let r = self.g().sub(v, m);
+            let h = self.push_rows(d, vec![("", r)], false);
+            self.out.joints.push(JointOut {
+                name: d.name.to_string(),
+                docs: d.docs.clone(),
+                kind: "Driver",
+                frames: [None, None],
+                holonomic: h,
+                nonholonomic: (idx(self.out.nonholonomic.len()), 0),
+            });
+            return Some(());
+        }
+        let a_e = fl.get("a")?;
+        let a = self.frame_of(a_e)?;
+        let b = match fl.get("b") {
+            Some(e) => self.frame_of(e)?,
+            None => None,
+        };
+        if a.is_none() && !matches!(kind.as_str(), "Driver") {
+            self.cx.error_spanned_by(
+                a_e,
+                "the first frame of a joint moves: it is not the ground (give the ground as `b`)",
+            );
+            return None;
+        }
+        if a == b && fl.get("b").is_some() {
+            self.cx.error_spanned_by(
+                fl.get("b")?,
+                format!(
+                    "joint `{}` joins `{}` to itself",
+                    d.name,
+                    a_e.to_token_stream()
+                ),
+            );
+            return None;
+        }
+        let dim = self.dim_of(a);
+        let fa = self.tr.frame_value(a, dim);
+        let fb = self.tr.frame_value(b, dim);
+        let nq = self.tr.nq();
+        let at_a = self.at(&fl, "at_a", dim)?;
+        let at_b = self.at(&fl, "at_b", dim)?;
+        let pa = fa.point(self.g(), &at_a);
+        let pb = fb.point(self.g(), &at_b);
+        let sep = sub_v(self.g(), &pa, &pb);
+        let xyz = ["x", "y", "z"];
+        let position_rows = |sep: &[ExprId]| -> Vec<(&'static str, ExprId)> {
+            sep.iter().enumerate().map(|(i, &e)| (xyz[i], e)).collect()
+        };
+        let axis = |s: &mut Self, name: &str| -> Option<(Vec<ExprId>, Vec<ExprId>, Vec<ExprId>)> {
+            let e = fl.get(name)?;
+            let v = s.vector(e, dim, Context::Kinematics)?;
+            s.basis(e, &v)
+        };
+        let rot = |s: &mut Self, f: &FrameValue, v: &[ExprId]| mat_vec(s.g(), dim, &f.rotation, v);
+        let relative_angle = |s: &mut Self| -> Option<ExprId> {
+            let (Some(x), Some(y)) = (fa.angle, fb.angle) else {
+                unreachable!("planar frames have angles")
+            };
+            let r = s.g().sub(x, y);
+            Some(match fl.get("angle") {
+                Some(e) => {
+                    let a0 = s.scalar(e, Context::Kinematics)?;
+                    s.g().sub(r, a0)
+                }
+                None => r,
+            })
+        };
+        let planar = dim == 2;
+        let mut h: Vec<(&str, ExprId)> = Vec::new();
+        let mut nh: Vec<(&str, ExprId)> = Vec::new();
+        let variant: &'static str = match (kind.as_str(), planar) {
+            ("Revolute", true) => {
+                for n in ["axis_a", "axis_b"] {
+                    if let Some(e) = fl.get(n) {
+                        self.cx.error_spanned_by(
+                            e,
+                            "a planar revolute joint turns about z and takes no axis",
+                        );
+                        return None;
+                    }
+                }
+                h = position_rows(&sep);
+                "PlanarRevolute"
+            }
+            ("Revolute", false)
+            | ("Universal", false)
+            | ("Cylindrical", false)
+            | ("Prismatic", false) => {
+                let (ua, p1a, p2a) = axis(self, "axis_a")?;
+                let (ub, p1b, p2b) = match fl.get("axis_b") {
+                    Some(_) => axis(self, "axis_b")?,
+                    None => (ua.clone(), p1a.clone(), p2a.clone()),
+                };
+                let wa = rot(self, &fa, &ua);
+                let wb = rot(self, &fb, &ub);
+                match kind.as_str() {
+                    "Universal" => {
+                        h = position_rows(&sep);
+                        let c = dot(self.g(), &wa, &wb);
+                        h.push(("cross", c));
+                        "Universal"
+                    }
+                    _ => {
+                        let q1 = rot(self, &fb, &p1b);
+                        let q2 = rot(self, &fb, &p2b);
+                        let c1 = dot(self.g(), &wa, &q1);
+                        let c2 = dot(self.g(), &wa, &q2);
+                        if kind == "Revolute" {
+                            h = position_rows(&sep);
+                        } else {
+                            let r1 = rot(self, &fa, &p1a);
+                            let r2 = rot(self, &fa, &p2a);
+                            let d1 = dot(self.g(), &sep, &r1);
+                            let d2 = dot(self.g(), &sep, &r2);
+                            h.push(("n1", d1));
+                            h.push(("n2", d2));
+                        }
+                        h.push(("axis1", c1));
+                        h.push(("axis2", c2));
+                        if kind == "Prismatic" {
+                            let r1 = rot(self, &fa, &p1a);
+                            let tw = dot(self.g(), &r1, &q2);
+                            h.push(("twist", tw));
+                            "Prismatic"
+                        } else if kind == "Revolute" {
+                            "Revolute"
+                        } else {
+                            "Cylindrical"
+                        }
+                    }
+                }
+            }
+            ("Spherical", false) => {
+                h = position_rows(&sep);
+                "Spherical"
+            }
+            ("Prismatic", true) => {
+                let (_, n, _) = axis(self, "axis_a")?;
+                if let Some(e) = fl.get("axis_b") {
+                    self.cx
+                        .error_spanned_by(e, "a planar prismatic joint slides along `axis_a` only");
+                    return None;
+                }
+                let nn = rot(self, &fa, &n);
+                let c = dot(self.g(), &sep, &nn);
+                h.push(("normal", c));
+                let r = relative_angle(self)?;
+                h.push(("angle", r));
+                "PlanarPrismatic"
+            }
+            ("Fixed", true) => {
+                h = position_rows(&sep);
+                let r = relative_angle(self)?;
+                h.push(("angle", r));
+                "PlanarFixed"
+            }
+            ("Fixed", false) => {
+                if let Some(e) = fl.get("angle") {
+                    self.cx.error_spanned_by(
+                        e,
+                        "a spatial fixed joint keeps the frames aligned and takes no `angle`",
+                    );
+                    return None;
+                }
+                h = position_rows(&sep);
+                let cols = |f: &FrameValue, k: usize| {
+                    (0..3).map(|i| f.rotation[3 * i + k]).collect::<Vec<_>>()
+                };
+                for (name, i, j) in [("yz", 1, 2), ("zx", 2, 0), ("xy", 0, 1)] {
+                    let x = cols(&fa, i);
+                    let y = cols(&fb, j);
+                    let c = dot(self.g(), &x, &y);
+                    h.push((name, c));
+                }
+                "Fixed"
+            }
+            ("Distance", _) => {
+                let l = self.scalar(fl.get("length")?, Context::Kinematics)?;
+                let s2 = dot(self.g(), &sep, &sep);
+                let l2 = self.g().mul(vec![l, l]);
+                h.push(("", self.g().sub(s2, l2)));
+                "Distance"
+            }
+            ("ZeroVelocity", _) | ("KnifeEdge", _) => {
+                if fl.get("b").is_some() {
+                    unreachable!("no field `b`")
+                }
+                let along = if kind == "KnifeEdge" {
+                    let e = fl.get("lateral")?;
+                    let v = self.vector(e, dim, Context::Kinematics)?;
+                    rot(self, &fa, &v)
+                } else {
+                    self.vector(fl.get("along")?, dim, Context::Kinematics)?
+                };
+                let v: Vec<ExprId> = pa
+                    .iter()
+                    .map(|&x| time_derivative(self.g(), nq, x))
+                    .collect();
+                nh.push(("", dot(self.g(), &v, &along)));
+                "ZeroVelocity"
+            }
+            ("RollingWheel", false) => {
+                let ax_e = fl.get("axis")?;
+                let axv = self.vector(ax_e, 3, Context::Kinematics)?;
+                let (u, _, _) = self.basis(ax_e, &axv)?;
+                let up = match fl.get("up") {
+                    Some(e) => {
+                        let v = self.vector(e, 3, Context::Kinematics)?;
+                        self.basis(e, &v)?
+                    }
+                    None => {
+                        let (o, z) = (self.g().constant(1.0), self.g().constant(0.0));
+                        (vec![z, z, o], vec![o, z, z], vec![z, o, z])
+                    }
+                };
+                let radius = self.scalar(fl.get("radius")?, Context::Kinematics)?;
+                let center = self.at(&fl, "center", 3)?;
+                let c = fa.point(self.g(), &center);
+                let a = rot(self, &fa, &u);
+                // Direction from the centre to the contact point: minus the part of `up`
+                // normal to the wheel's axis, normalized.
+                let na = dot(self.g(), &up.0, &a);
+                let proj = scale_v(self.g(), na, &a);
+                let w = sub_v(self.g(), &up.0, &proj);
+                let wsq = dot(self.g(), &w, &w);
+                let wn = self.g().call(Func::Sqrt, wsq);
+                let mr = self.g().neg(radius);
+                let s = self.g().div(mr, wn);
+                let down = scale_v(self.g(), s, &w);
+                let p = add_v(self.g(), &c, &down);
+                h.push(("contact", dot(self.g(), &p, &up.0)));
+                let vc: Vec<ExprId> = c
+                    .iter()
+                    .map(|&x| time_derivative(self.g(), nq, x))
+                    .collect();
+                let Value::Vector(omega) = fa.angular_velocity(self.g(), nq) else {
+                    unreachable!("spatial frames have a vector rate")
+                };
+                let spin = cross(self.g(), &omega, &down);
+                let vp = add_v(self.g(), &vc, &spin);
+                nh.push(("longitudinal", dot(self.g(), &vp, &up.1)));
+                nh.push(("lateral", dot(self.g(), &vp, &up.2)));
+                "RollingWheel"
+            }
+            (k, planar) => {
+                self.cx.error_at(
+                    fl.span,
+                    format!(
+                        "`{k}` is a {} joint; this model is {}",
+                        if planar { "spatial" } else { "planar" },
+                        if planar { "planar" } else { "spatial" }
+                    ),
+                );
+                return None;
+            }
+        };
+        let hr = self.push_rows(d, h, false);
+        let nr = self.push_rows(d, nh, true);
+        self.out.joints.push(JointOut {
+            name: d.name.to_string(),
+            docs: d.docs.clone(),
+            kind: variant,
+            frames: [a.map(idx), b.map(idx)],
+            holonomic: hr,
+            nonholonomic: nr,
+        });
+        Some(())
+    }
+
+    fn add_applied(&mut self, q: Vec<ExprId>) {
+        for (i, c) in q.into_iter().enumerate() {
+            let s = self.out.applied[i];
+            self.out.applied[i] = self.g().add(vec![s, c]);
+        }
+        self.out.has_applied = true;
+    }
+
+    fn force(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, FORCE_KINDS, "force element")?;
+        let nq = self.tr.nq();
+        match fl.kind.as_str() {
+            "Gravity" => {
+                let e = fl.get("acceleration")?;
+                let v = match self.tr.field_value(e, Context::Kinematics)? {
+                    Value::Vector(v) => v,
+                    other => {
+                        self.cx.error_spanned_by(
+                            e,
+                            format!("gravity is a vector; this is {}", other.describe()),
+                        );
+                        return None;
+                    }
+                };
+                if self.gravity.is_some() {
+                    self.cx
+                        .error_spanned_by(&d.name, "gravity is declared twice");
+                    return None;
+                }
+                self.gravity = Some((v, e.span()));
+            }
+            "SpringDamper" => {
+                let a = self.frame_of(fl.get("a")?)?;
+                let b = match fl.get("b") {
+                    Some(e) => self.frame_of(e)?,
+                    None => None,
+                };
+                let dim = self.dim_of(a);
+                let (fa, fb) = (self.tr.frame_value(a, dim), self.tr.frame_value(b, dim));
+                let at_a = self.at(&fl, "at_a", dim)?;
+                let at_b = self.at(&fl, "at_b", dim)?;
+                let pa = fa.point(self.g(), &at_a);
+                let pb = fb.point(self.g(), &at_b);
+                let sep = sub_v(self.g(), &pa, &pb);
+                let l2 = dot(self.g(), &sep, &sep);
+                let l = self.g().call(Func::Sqrt, l2);
+                let k = self.scalar(fl.get("stiffness")?, Context::Kinematics)?;
+                let l0 = self.scalar(fl.get("rest_length")?, Context::Kinematics)?;
+                let ext = self.g().sub(l, l0);
+                let half = self.g().constant(0.5);
+                let v = self.g().mul(vec![half, k, ext, ext]);
+                self.potential.push(v);
+                if let Some(ce) = fl.get("damping") {
+                    let c = self.scalar(ce, Context::Kinematics)?;
+                    let ld = time_derivative(self.g(), nq, l);
+                    let q = (0..nq)
+                        .map(|i| {
+                            let dl = diff::differentiate(self.g(), l, Var::Q(idx(i)));
+                            let m = self.g().mul(vec![c, ld, dl]);
+                            self.g().neg(m)
+                        })
+                        .collect();
+                    self.add_applied(q);
+                }
+            }
+            "PointForce" => {
+                let a = self.frame_of(fl.get("a")?)?;
+                let dim = self.dim_of(a);
+                let fa = self.tr.frame_value(a, dim);
+                let at = self.at(&fl, "at_a", dim)?;
+                let p = fa.point(self.g(), &at);
+                let f = self.vector(fl.get("force")?, dim, Context::Force)?;
+                let q = (0..nq)
+                    .map(|i| {
+                        let dp: Vec<ExprId> = p
+                            .iter()
+                            .map(|&x| diff::differentiate(self.g(), x, Var::Q(idx(i))))
+                            .collect();
+                        dot(self.g(), &f, &dp)
+                    })
+                    .collect();
+                self.add_applied(q);
+            }
+            "Torque" => {
+                let a = self.frame_of(fl.get("a")?)?;
+                let dim = self.dim_of(a);
+                let fa = self.tr.frame_value(a, dim);
+                let te = fl.get("torque")?;
+                let w = fa.angular_velocity(self.g(), nq);
+                let q: Vec<ExprId> = match w {
+                    Value::Scalar(w) => {
+                        let tau = self.scalar(te, Context::Force)?;
+                        (0..nq)
+                            .map(|i| {
+                                let dw = diff::differentiate(self.g(), w, Var::Qd(idx(i)));
+                                self.g().mul(vec![tau, dw])
+                            })
+                            .collect()
+                    }
+                    Value::Vector(w) => {
+                        let tau = self.vector(te, 3, Context::Force)?;
+                        (0..nq)
+                            .map(|i| {
+                                let dw: Vec<ExprId> = w
+                                    .iter()
+                                    .map(|&x| diff::differentiate(self.g(), x, Var::Qd(idx(i))))
+                                    .collect();
+                                dot(self.g(), &tau, &dw)
+                            })
+                            .collect()
+                    }
+                    _ => unreachable!("angular velocities are scalars or vectors"),
+                };
+                self.add_applied(q);
+            }
+            _ => unreachable!("force kinds are listed"),
+        }
+        Some(())
+    }
+}
