@@ -437,7 +437,7 @@ def render_rhs(tables):
     return "\n".join(lines)
 
 
-def machine(pfaff):
+def machine(pfaff, load_start):
     cpu = platform.processor() or "?"
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
@@ -454,11 +454,11 @@ def machine(pfaff):
             return "?"
 
     commit = tool_version(["git", "-C", HERE, "log", "-1", "--format=%h %s"])
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    load = ", ".join(f"{x[0]:.1f}" for x in (load_start, os.getloadavg()))
     return "\n".join([
         f"- date: {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')}",
         f"- CPU: {cpu}, {os.cpu_count()} logical cores; {platform.system()} {platform.release()}; "
-        f"load average at the end {load}",
+        f"load average (1 min) at the start and at the end {load} (above the number of cores, other work shares the machine)",
         f"- pfaff: {tool_version([pfaff, '--version'])}, commit {commit}; {tool_version(['rustc', '--version'])}",
         f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {scipy.__version__}, "
         f"CasADi {casadi.__version__} (SUNDIALS plugins of its wheel); {tool_version(['gcc', '--version'])}, flags {' '.join(CFLAGS)}",
@@ -478,6 +478,7 @@ def main():
                         help="andrews' reference: the test set's values, or a converged pfaff run")  # fmt: skip
     parser.add_argument("--output", help="also write the report (Markdown) to this file")
     args = parser.parse_args()
+    load_start = os.getloadavg()
 
     import casadi as ca
 
@@ -523,7 +524,7 @@ def main():
     )
     report = "\n\n".join([
         "# pfaff and its peers",
-        machine(args.pfaff),
+        machine(args.pfaff, load_start),
         f"Final position error (largest absolute error of the coordinates at the end: {spans}; "
         "pendulum against its closed form, andrews and car_axis against the test-set references), "
         "right-hand-side evaluations and wall time (best of several runs). "
