@@ -94,6 +94,19 @@ pub trait Integrator {
     /// A wrong length or a non-finite value; the state is then left unchanged.
     fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError>;
 
+    /// Like [`set_state`](Self::set_state), for a correction to which the right-hand
+    /// side is invariant, $f(t, y_\text{new}) = f(t, y)$ (moving coordinates that $f$
+    /// recomputes from the others, as the partitioning formulation of [`crate::sim`]
+    /// does): the derivative the method keeps for the current state stays valid, so an
+    /// embedded pair reuses it (FSAL) instead of evaluating $f$ again. The default is
+    /// [`set_state`](Self::set_state), right for methods whose `set_state` keeps it.
+    ///
+    /// # Errors
+    /// As [`set_state`](Self::set_state).
+    fn set_state_keeping_derivative(&mut self, y: &[f64]) -> Result<(), OdeError> {
+        self.set_state(y)
+    }
+
     /// Work counters.
     fn stats(&self) -> &OdeStats;
 

@@ -293,12 +293,12 @@ impl<M: EmbeddedRk> RkDriver<M> {
         self.m.dense((t - st.t_prev) / st.h_last, out)
     }
 
-    /// Replaces $y$. The FSAL derivative becomes stale, so the next step evaluates
-    /// $f(t, y)$ once more.
-    pub(crate) fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
+    /// Replaces $y$. Unless `keep_derivative`, the FSAL derivative becomes stale, so the
+    /// next step evaluates $f(t, y)$ once more.
+    pub(crate) fn set_state(&mut self, y: &[f64], keep_derivative: bool) -> Result<(), OdeError> {
         let st = &mut self.st;
         replace_state(st.t, &mut st.y, y, &mut st.stats)?;
-        st.fsal = false;
+        st.fsal &= keep_derivative;
         Ok(())
     }
 }
@@ -357,7 +357,12 @@ macro_rules! embedded_rk_integrator {
             /// Replaces $y$. The FSAL derivative becomes stale, so the next step
             /// evaluates $f(t, y)$ once more.
             fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
-                self.0.set_state(y)
+                self.0.set_state(y, false)
+            }
+
+            /// Replaces $y$ and keeps the FSAL derivative.
+            fn set_state_keeping_derivative(&mut self, y: &[f64]) -> Result<(), OdeError> {
+                self.0.set_state(y, true)
             }
 
             fn stats(&self) -> &OdeStats {

@@ -26,12 +26,9 @@ use crate::kinematics::KinematicsError;
 use crate::ode::{OdeError, OdeOptions, Tolerances};
 use crate::workspace::EvalError;
 use crate::{
-    AssemblyError, Error, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
+    AssemblyError, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
     Preferences, Prescription,
 };
-
-/// Relative progress below which a recovery counts as a stall.
-const STALL: f64 = 1e-10;
 
 /// Pivot ratio below which constraints are reported as nearly dependent in a failure.
 const NEAR_SINGULAR: f64 = 1e-3;
@@ -102,9 +99,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
 
     /// Records a row at the current full state.
     fn record(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        self.sys
-            .accelerations(t)
-            .map_err(|e| SimErrorKind::from_analysis(e, Vec::new()))?;
+        self.sys.accelerations(t)?;
         let v = self.observe(t)?;
         let energy = self
             .monitors
@@ -185,22 +180,6 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     }
 }
 
-/// Whether a right-hand-side failure is a kinematic one that a new partition may cure.
-fn recoverable(e: &OdeError) -> bool {
-    match e {
-        OdeError::Rhs { source, .. } => matches!(
-            source.downcast_ref::<Error>(),
-            Some(Error::Kinematics(
-                KinematicsError::NewtonFailed { .. }
-                    | KinematicsError::BranchSwitch { .. }
-                    | KinematicsError::SingularDependent { .. }
-                    | KinematicsError::SingularVelocity { .. }
-            ))
-        ),
-        _ => false,
-    }
-}
-
 #[allow(clippy::too_many_lines)]
 pub(super) fn run<M: Mechanism + ?Sized>(
     sim: &mut Simulation<'_, M>,
@@ -209,7 +188,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let started = Instant::now();
     let mech = sim.mech;
     let info = mech.info();
-    let (n, mh) = (info.nq(), info.nh());
+    let n = info.nq();
     let t0 = sim.t0;
     let form = sim.formulation;
     let empty = |kind| SimError {
@@ -246,8 +225,14 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             (q, qd)
         }
     };
-    let mut sys = MechSystem::new(mech, form, sim.kinematics, sim.dynamics)
-        .map_err(|e| empty(SimErrorKind::Analysis(e)))?;
+    let mut sys = MechSystem::new(
+        mech,
+        form,
+        sim.kinematics,
+        sim.dynamics,
+        (sim.rtol, sim.atol),
+    )
+    .map_err(|e| empty(SimErrorKind::Analysis(e)))?;
     let pq: Vec<(&str, f64)> = sim
         .prescribed_q
         .iter()
@@ -267,15 +252,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         .map_err(|e| empty(assembly_error(e)))?;
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
-    sys.t_state = t0;
     sys.redundant = sys.fit_rows();
-    if form == Formulation::Partitioning {
-        // Assembly left its partition current: Algorithm P with the prescribed
-        // coordinates kept independent (exactly Algorithm P without a prescription).
-        sys.update_indices();
-        if let Err(e) = sys.accept(t0) {
-            return Err(empty(SimErrorKind::from_analysis(e, Vec::new())));
-        }
+    if let Err(e) = sys.accept(t0) {
+        return Err(empty(e));
     }
 
     let rows = match sim.output {
@@ -296,17 +275,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
 
     // Integrator.
-    let span = t_end - t0;
-    let mut h_max = sim.h_max.unwrap_or(f64::INFINITY);
-    if form == Formulation::Partitioning && n == mh && sim.h_max.is_none() {
-        // No degrees of freedom: the inert state gives the error control nothing to
-        // measure, so the output spacing bounds the step (K1 needs a near guess).
-        let spacing = match &sim.output {
-            Output::Every(dt) => *dt,
-            Output::Times(_) | Output::Steps => span / 100.0,
-        };
-        h_max = spacing.min(span / 100.0);
-    }
+    let h_max = sim.h_max.unwrap_or(f64::INFINITY);
     if let Some(h) = sim.h_init.filter(|h| h.is_nan() || *h <= 0.0) {
         // The run goes forward: a negative first step is a bad step size, not a
         // backward integration.
@@ -333,11 +302,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
 
     let mut yout = vec![0.0; dim];
-    let mut q_acc = rec.sys.q.clone();
-    let mut qd_acc = rec.sys.qd.clone();
     let mut next_out = 0;
-    let (mut last_fail_t, mut stalls) = (f64::NEG_INFINITY, 0_u32);
-    let mut pending: Option<OdeError> = None;
     let steps_mode = matches!(sim.output, Output::Steps);
 
     macro_rules! bail {
@@ -353,7 +318,6 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             }
         };
     }
-    let analysis = |e: Error| SimErrorKind::from_analysis(e, Vec::new());
     let ode = |e: OdeError| SimErrorKind::from_ode(e, Vec::new());
 
     while stepper.t() < t_end {
@@ -364,105 +328,55 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 steps: sim.max_steps
             });
         }
-        match stepper.step(&mut rec.sys, Some(t_end)) {
-            Ok(t) => {
-                pending = None;
-                if form == Formulation::Projection {
-                    rec.y.copy_from_slice(stepper.y());
-                    check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
-                    check!(rec.sys.project(t));
-                    rec.sys.gather(rec.y);
-                    check!(stepper.set_state(rec.y).map_err(ode));
-                }
-                while next_out < times.len() && times[next_out] <= t {
-                    let to = times[next_out];
-                    check!(stepper.interpolate(to, &mut yout).map_err(ode));
-                    check!(rec.sys.reconstruct(to, &yout).map_err(analysis));
-                    if form == Formulation::Projection {
-                        check!(rec.sys.project(to));
-                    }
-                    check!(rec.record(to));
-                    next_out += 1;
-                }
-                rec.y.copy_from_slice(stepper.y());
-                check!(rec.sys.reconstruct(t, rec.y).map_err(analysis));
-                if steps_mode {
-                    check!(rec.record(t));
-                } else {
-                    check!(rec.observe(t));
-                }
-                if form == Formulation::Partitioning {
-                    q_acc.copy_from_slice(&rec.sys.q);
-                    qd_acc.copy_from_slice(&rec.sys.qd);
-                    let sys = &mut rec.sys;
-                    let moved = check!(sys
-                        .kin
-                        .monitor(mech, &mut sys.ws, t, &sys.q)
-                        .map_err(|e| analysis(e.into())));
-                    check!(rec.sys.accept(t).map_err(analysis));
-                    let changed = moved && t < t_end && rec.sys.update_indices();
-                    if rec.sys.rank_changed {
-                        bail!(rank_changed(&rec.sys, t));
-                    }
-                    if changed {
-                        check!(rec.sys.accept(t).map_err(analysis));
-                        rec.sys.gather(rec.y);
-                        check!(stepper.reset(&mut rec.sys, t, rec.y, None).map_err(ode));
-                    }
-                }
-                if let Some(f) = sim.progress.as_mut() {
-                    f(t);
-                }
-            }
+        let t = match stepper.step(&mut rec.sys, Some(t_end)) {
+            Ok(t) => t,
             Err(e) => {
-                // After a recovery at this time, the step size that underflows on the
-                // retry is a symptom: report the kinematic failure that started it.
-                let e = match (e, pending.take()) {
-                    (OdeError::StepSizeTooSmall { t, .. }, Some(k))
-                        if k.t().is_some_and(|tk| t - tk <= STALL * span) =>
-                    {
-                        k
-                    }
-                    (e, _) => e,
-                };
                 let constraints = std::mem::take(&mut rec.sys.failure_constraints);
-                if form != Formulation::Partitioning || !recoverable(&e) {
-                    bail!(SimErrorKind::from_ode(e, constraints));
-                }
-                let ta = stepper.t();
-                if ta - last_fail_t <= STALL * span {
-                    stalls += 1;
-                } else {
-                    stalls = 0;
-                }
-                last_fail_t = ta;
-                if stalls >= 3 || (stepper.is_fixed_step() && stalls >= 1) {
-                    bail!(SimErrorKind::from_ode(e, constraints));
-                }
-                rec.sys.q.copy_from_slice(&q_acc);
-                rec.sys.qd.copy_from_slice(&qd_acc);
-                rec.sys.t_state = ta;
-                let sys = &mut rec.sys;
-                if sys.kin.repartition(mech, &mut sys.ws, ta, &q_acc).is_err() {
-                    bail!(SimErrorKind::from_ode(e, constraints));
-                }
-                rec.sys.update_indices();
-                if rec.sys.rank_changed {
-                    bail!(rank_changed(&rec.sys, ta));
-                }
-                check!(rec.sys.accept(ta).map_err(analysis));
-                rec.sys.gather(rec.y);
-                let h = stepper.h_next().abs() / 8.0;
-                let h0 = (!stepper.is_fixed_step() && h.is_finite() && h > 0.0).then_some(h);
-                check!(stepper.reset(&mut rec.sys, ta, rec.y, h0).map_err(ode));
-                rec.sys.failure_constraints = constraints;
-                pending = Some(e);
+                bail!(SimErrorKind::from_ode(e, constraints));
             }
+        };
+        rec.y.copy_from_slice(stepper.y());
+        check!(rec.sys.reconstruct_exact(t, rec.y));
+        match form {
+            Formulation::Partitioning => {
+                // The integrated state moved onto the manifold: the right-hand side is
+                // invariant to the move, so the integrator keeps its derivatives. The
+                // state becomes the anchor of the next step's chart.
+                rec.sys.gather(rec.y);
+                check!(stepper.set_state_keeping_derivative(rec.y).map_err(ode));
+                check!(rec.sys.accept(t));
+            }
+            Formulation::Projection => {
+                check!(rec.sys.project(t));
+                rec.sys.gather(rec.y);
+                check!(stepper.set_state(rec.y).map_err(ode));
+            }
+            Formulation::Baumgarte { .. } => {}
+        }
+        // The accepted state is current: its row (or its monitors), then the rows of
+        // the output times the step passed, which overwrite the full state.
+        if steps_mode {
+            check!(rec.record(t));
+        } else {
+            check!(rec.observe(t));
+        }
+        while next_out < times.len() && times[next_out] <= t {
+            let to = times[next_out];
+            check!(stepper.interpolate(to, &mut yout).map_err(ode));
+            check!(rec.sys.reconstruct_exact(to, &yout));
+            if form == Formulation::Projection {
+                check!(rec.sys.project(to));
+            }
+            check!(rec.record(to));
+            next_out += 1;
+        }
+        if let Some(f) = sim.progress.as_mut() {
+            f(t);
         }
     }
     if rec.traj.t.last() != Some(&t_end) {
         rec.y.copy_from_slice(stepper.y());
-        check!(rec.sys.reconstruct(t_end, rec.y).map_err(analysis));
+        check!(rec.sys.reconstruct_exact(t_end, rec.y));
         check!(rec.record(t_end));
     }
     Ok(rec.run(Some(&stepper)))
@@ -482,28 +396,6 @@ fn assembly_error(e: AssemblyError) -> SimErrorKind {
     match eval {
         Some(v @ EvalError::NonFinite { .. }) => SimErrorKind::from_eval(v.clone()),
         _ => SimErrorKind::Assembly(e),
-    }
-}
-
-/// The rank of $C_q$ changed at a re-partition (redundant constraints that stop being
-/// redundant, or new ones): the motion went through a singular configuration.
-fn rank_changed<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>, t: f64) -> SimErrorKind {
-    let info = sys.info;
-    let constraints = sys
-        .kin
-        .partition()
-        .map(|p| {
-            p.redundant_rows()
-                .iter()
-                .map(|&i| info.holonomic[i].name)
-                .collect()
-        })
-        .unwrap_or_default();
-    SimErrorKind::Singular {
-        t,
-        matrix: super::SingularMatrix::DependentPositions,
-        ratio: 0.0,
-        constraints,
     }
 }
 

@@ -270,8 +270,17 @@ impl SimErrorKind {
                     component,
                 },
             },
-            e @ OdeError::Rhs { .. } => match e.into_rhs_error::<Error>() {
-                Ok((_, inner)) => Self::from_analysis(inner, constraints),
+            e @ OdeError::Rhs { .. } => match e.into_rhs_error::<Self>() {
+                Ok((_, mut kind)) => {
+                    if let Self::NewtonFailed { constraints: c, .. }
+                    | Self::Singular { constraints: c, .. } = &mut kind
+                    {
+                        if c.is_empty() {
+                            *c = constraints;
+                        }
+                    }
+                    kind
+                }
                 Err(other) => Self::Integrator(other),
             },
             other => Self::Integrator(other),

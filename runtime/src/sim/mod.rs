@@ -11,18 +11,27 @@
 //! $$\begin{bmatrix}M & J^\mathsf{T}\\ J & 0\end{bmatrix}
 //!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix}.$$
-//! - [`Formulation::Partitioning`] (math-spec Algorithm D): the state is
-//!   $y = [p; \dot\gamma]$ with $p = [\eta; \gamma]$, of dimension
-//!   $2(n - r) - m_{nh}$ ($r$ the rank of $C_q$, $m_h$ unless Algorithm P dropped
-//!   redundant rows). Each evaluation runs K1 (Newton on $\beta$ from the last accepted
-//!   state's $\beta$ moved along $\dot\beta$ to the new time), K2 and (E31). An
-//!   evaluation whose K1 fails or lands on another solution branch (the sign of
-//!   $\det J_d$ changed, or Newton corrected the guess by more than the predicted move)
-//!   is a recoverable failure: the integrator rejects the attempt and retries a quarter
-//!   of the step. After each accepted step the condition monitor may re-partition; a
-//!   failure that persists re-partitions at the last accepted state and retries with a
-//!   smaller step. Both change the meaning of $y$, so the integrator restarts (Adams at
-//!   order 1). Constraints hold to the Newton tolerance at every evaluation: no drift.
+//! - [`Formulation::Partitioning`] (math-spec Algorithm D in local coordinates): the
+//!   integrator carries $y = [q; \dot q]$, but the right-hand side is a function of
+//!   independent coordinates only. At each evaluation $y$ is moved onto the manifold
+//!   in the *chart* of the last accepted state $q_a$: the dependent coordinates are the
+//!   $r$ components along the rows of $C_q(q_a)$ (an orthonormal-quality partition,
+//!   renewed at every step, so never near a singular one), found by Newton from the
+//!   integrator's own prediction with the factorization of $C_q C_q^\mathsf{T}$ made
+//!   at $q_a$ and stopped at a fraction of the integrator's tolerance (one update per
+//!   evaluation is the norm); the dependent velocities come from the orthogonal
+//!   projection onto $J\dot q + [C_t; g] = 0$; then (E31). Since the dependent
+//!   coordinates are integrated too, the error test sees their error, the Newton
+//!   guess is the integrator's prediction, and a change of chart changes nothing the
+//!   integrator holds: no restart. Accepted and output states are polished to the
+//!   Newton tolerance [`NEWTON_TOLERANCE`] (constraints hold there, no drift) and
+//!   handed back to the integrator, which keeps its derivatives (the right-hand side
+//!   is invariant to the correction). An evaluation whose Newton iteration diverges,
+//!   or corrects the prediction by more than it moved from the last accepted state
+//!   (another intersection of the normal space with the manifold), is a recoverable
+//!   failure: the integrator rejects the attempt and retries a quarter of the step.
+//!   The choice of this chart over a partition of the coordinates themselves, with the
+//!   measurements behind it, is explained in `ARCHITECTURE.md`.
 //! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
 //!   step $q$ is projected onto $C(q,t) = 0$ by Newton with minimum-norm corrections
 //!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and $\dot q$ onto
@@ -76,6 +85,7 @@
 //! # Ok::<(), pfaff::sim::SimError>(())
 //! ```
 
+mod chart;
 mod driver;
 mod error;
 mod precision;
@@ -89,27 +99,13 @@ pub use trajectory::{Monitors, Run, Stats, Trajectory};
 
 use crate::{DynamicsParams, KinematicsParams, Mechanism, NewtonParams, PartitionParams};
 
-/// The simulation's Newton tolerance (K1 and the position projection), relative as in
-/// [`NewtonParams`].
+/// The simulation's Newton tolerance (assembly and the states a run keeps: accepted,
+/// output and projected ones), relative as in [`NewtonParams`].
 ///
-/// K1 accepts its guess without an update when the residual is already below the
-/// tolerance; with the first-order predictor of the guess that happens at most steps,
-/// and a residual of $10^{-12}$ in the units of $C$ (metres for a loop closure of
+/// A residual of $10^{-12}$ in the units of $C$ (metres for a loop closure of
 /// centimetre-sized links) leaves angles wrong by $10^{-10}$, which a DOP853 run at
 /// rtol $10^{-12}$ sees as noise. $10^{-14}$ keeps the coordinates at round-off.
 pub const NEWTON_TOLERANCE: f64 = 1e-14;
-
-/// The simulation's re-partition threshold: re-partition when a pivot ratio of the
-/// dependent block falls below this fraction of its value at partition time.
-///
-/// Algorithm P suggests $10^{-3}$ for kinematic analysis, but the state-space ODE (E36)
-/// is as ill-conditioned as $C_\beta$: with the Cartesian pendulum and $\beta = \{x\}$,
-/// $\dot x = -y\dot y/x$, so at a ratio of $10^{-3}$ the dependent velocity amplifies
-/// errors in $\dot y$ a thousandfold and fixed-step or loosely controlled runs lose the
-/// solution before the switch. At $0.3$ the amplification stays below about 3. A
-/// re-partition that picks the same coordinates only renews the reference ratios and does
-/// not restart the integrator.
-pub const DETERIORATION: f64 = 0.3;
 
 /// The simulation's tolerance for the inconsistency of redundant constraints (see
 /// [`DynamicsParams::redundant_tolerance`]).
@@ -262,7 +258,6 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
             prescribed_qd: Vec::new(),
             kinematics: KinematicsParams {
                 partition: PartitionParams {
-                    deterioration: DETERIORATION,
                     allow_redundant: true,
                     ..PartitionParams::default()
                 },
@@ -374,8 +369,8 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
         self
     }
 
-    /// Tuning of K1, K2 and Algorithm P (defaults: Newton tolerance
-    /// [`NEWTON_TOLERANCE`], re-partition threshold [`DETERIORATION`]).
+    /// Tuning of assembly (K1, K2, Algorithm P) and of the Newton tolerance of kept
+    /// states (default [`NEWTON_TOLERANCE`]).
     #[must_use]
     pub fn kinematics(mut self, params: KinematicsParams) -> Self {
         self.kinematics = params;

@@ -38,10 +38,6 @@ impl Stepper {
         })
     }
 
-    pub fn is_fixed_step(&self) -> bool {
-        matches!(self, Self::Rk4(_))
-    }
-
     pub fn reset<S: OdeSystem + ?Sized>(
         &mut self,
         sys: &mut S,
@@ -68,16 +64,16 @@ impl Stepper {
         each!(self, i => i.y())
     }
 
-    pub fn h_next(&self) -> f64 {
-        each!(self, i => i.h_next())
-    }
-
     pub fn interpolate(&self, t: f64, out: &mut [f64]) -> Result<(), OdeError> {
         each!(self, i => i.interpolate(t, out))
     }
 
     pub fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
         each!(self, i => i.set_state(y))
+    }
+
+    pub fn set_state_keeping_derivative(&mut self, y: &[f64]) -> Result<(), OdeError> {
+        each!(self, i => i.set_state_keeping_derivative(y))
     }
 
     pub fn stats(&self) -> &OdeStats {

@@ -2,37 +2,41 @@
 //! evaluations the driver applies to accepted and output states.
 //!
 //! Input: a mechanism, a formulation and the analysis scratch. Output: an
-//! [`OdeSystem`] on
-//! - partitioning: $y = [p; \dot\gamma]$, $p = [\eta; \gamma]$, $\dot y = [\dot\eta;
-//!   \dot\gamma; \ddot\gamma]$ (Algorithm D; a mechanism without degrees of freedom gets
-//!   one inert component so that the integrators have a state);
-//! - projection and Baumgarte: $y = [q; \dot q]$, $\dot y = [\dot q; \ddot q]$.
+//! [`OdeSystem`] on $y = [q; \dot q]$ with $\dot y = [\dot q; \ddot q]$ for every
+//! formulation. They differ in what the right-hand side does with $y$:
+//! - partitioning: $y$ is moved onto the manifold in the local chart of the last
+//!   accepted state ([`Chart`]: Newton on the normal coordinates from the integrator's
+//!   prediction, then the orthogonal projection of the velocities), so $\dot y$ depends
+//!   on the chart's independent (tangential) coordinates only, and the integrator's
+//!   error test sees every coordinate;
+//! - projection and Baumgarte: $\ddot q$ of the index-1 system at $y$ as it is.
 //!
 //! Invariant: all buffers are sized in [`MechSystem::new`]; `rhs`, `reconstruct`,
 //! `project`, `accelerations` and `violations` do not allocate (except when building an
 //! error).
 
+use super::chart::{Chart, ChartFailure};
 use super::error::{SimErrorKind, SingularMatrix};
 use super::Formulation;
 use crate::dynamics::{Dynamics, DynamicsParams};
-use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams};
-use crate::linalg::dense::DenseLu;
+use crate::kinematics::{Kinematics, KinematicsParams};
+use crate::linalg::dense::{gram_factor, DenseLu};
 use crate::linalg::inf_norm;
 use crate::ode::{OdeSystem, RhsError};
 use crate::workspace::{EvalError, Workspace};
 use crate::{Error, Info, Mechanism};
 
-/// Pivot ratio below which the projection matrix counts as singular.
-const SINGULAR_RATIO: f64 = 1e-14;
+/// Pivot ratio below which a projection matrix counts as singular.
+const SINGULAR_RATIO: f64 = super::chart::SINGULAR_RATIO;
 
-/// Recoverable kinematic failures in a row (since the last accepted step) before a
-/// failure stops the integrator: with the integrators' cut of 4 per failure the step
-/// has then shrunk by $4^{10} \approx 10^6$, and the driver's re-partition is the
-/// better cure.
+/// Recoverable failures in a row (since the last accepted step) before a failure stops
+/// the integrator: with the integrators' cut of 4 per failure the step has then shrunk
+/// by $4^{10} \approx 10^6$.
 const MAX_RETRIES: u32 = 10;
 
-/// Relative size of a Newton correction of the K1 guess that never counts as a branch
-/// switch (see [`MechSystem::rhs`]), for the evaluations that hardly move.
+/// Relative size of a Newton correction of the integrator's prediction that never
+/// counts as a branch switch (see [`MechSystem::rhs`]), for the evaluations that hardly
+/// move (a correction within the integrator's tolerance never counts either).
 const BRANCH_FLOOR: f64 = 1e-8;
 
 pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
@@ -42,7 +46,7 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     pub ws: Workspace,
     pub kin: Kinematics,
     pub dynamics: Dynamics,
-    /// Current full coordinates (also the Newton guess of the next K1).
+    /// Current full coordinates.
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
@@ -52,39 +56,27 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     mu: Vec<f64>,
     lu_h: DenseLu,
     lu_v: DenseLu,
-    /// Partitioning: $[\eta; \gamma]$ and $\gamma$.
-    coords: Vec<usize>,
-    gamma: Vec<usize>,
-    dim: usize,
-    /// Time of the full state in `q`, `qd` (the base of the next K1 guess).
-    pub t_state: f64,
+    /// Partitioning: the chart of the last accepted state.
+    chart: Chart,
     pub newton_iterations: u64,
     pub factorizations: u64,
     /// Holonomic constraints not met when the last analysis failed.
     pub failure_constraints: Vec<&'static str>,
     /// Constraints the augmented solve found redundant so far.
     pub redundant: Vec<&'static str>,
-    /// Projection: the constraint rows projected on, the first `rows_h` holonomic
-    /// (all rows unless Algorithm P dropped redundant ones, see [`Self::fit_rows`]).
+    /// The constraint rows projected on, the first `rows_h` holonomic (all rows unless
+    /// Algorithm P dropped redundant ones, see [`Self::fit_rows`]).
     rows: Vec<usize>,
     rows_h: usize,
-    /// Partitioning: the last accepted full state, its time and the sign of
-    /// $\det J_d$ there (the reference of the branch check).
+    /// Partitioning: the last accepted full state (the reference of the branch check).
     q_acc: Vec<f64>,
-    qd_acc: Vec<f64>,
-    t_acc: f64,
-    sign_acc: f64,
     /// Recoverable failures since the last accepted step.
     retries: u32,
-    /// Whether `q_acc`, `qd_acc` hold an accepted state.
-    anchored: bool,
-    /// A re-partition found another rank of $C_q$ than the first partition.
-    pub rank_changed: bool,
-    /// Partitioning, the last K1: its guess, the largest move of a coordinate from the
-    /// base state to the guess, and the largest Newton correction of the guess.
-    guess: Vec<f64>,
-    moved: f64,
-    correction: f64,
+    /// Partitioning: the `(t, y)` whose corrected state is in `q`, `qd` (the last
+    /// [`reconstruct`](Self::reconstruct)), so that the driver's reconstruction of an
+    /// accepted state the integrator has just evaluated costs nothing.
+    cached: Option<f64>,
+    y_cached: Vec<f64>,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for MechSystem<'_, M> {
@@ -102,14 +94,11 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         form: Formulation,
         kin: KinematicsParams,
         dynamics: DynamicsParams,
+        (rtol, atol): (f64, f64),
     ) -> Result<Self, Error> {
         let info = mech.info();
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
-        let dim = match form {
-            Formulation::Partitioning => (2 * (n - mh) - info.nnh()).max(1),
-            _ => 2 * n,
-        };
-        let projection = matches!(form, Formulation::Projection);
+        let projection = !matches!(form, Formulation::Baumgarte { .. });
         Ok(Self {
             mech,
             info,
@@ -126,10 +115,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             mu: vec![0.0; m],
             lu_h: DenseLu::new(if projection { mh } else { 0 }, 1),
             lu_v: DenseLu::new(if projection { m } else { 0 }, 1),
-            coords: Vec::with_capacity(n),
-            gamma: Vec::with_capacity(n),
-            dim,
-            t_state: 0.0,
+            chart: Chart::new(n, m, mh, rtol, atol),
             newton_iterations: 0,
             factorizations: 0,
             failure_constraints: Vec::new(),
@@ -137,209 +123,163 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             rows: (0..m).collect(),
             rows_h: mh,
             q_acc: vec![0.0; n],
-            qd_acc: vec![0.0; n],
-            t_acc: 0.0,
-            sign_acc: 0.0,
             retries: 0,
-            anchored: false,
-            rank_changed: false,
-            guess: vec![0.0; n],
-            moved: 0.0,
-            correction: 0.0,
+            cached: None,
+            y_cached: vec![0.0; 2 * n],
         })
     }
 
-    /// Fits the state dimension (partitioning) or the projected rows (projection) to
-    /// the partition of the assembly, which may have dropped redundant holonomic
-    /// constraints; returns the names of the dropped ones.
+    /// Fits the projected rows (partitioning and projection) to the partition of the
+    /// assembly, which may have dropped redundant holonomic constraints; returns the
+    /// names of the dropped ones.
     pub fn fit_rows(&mut self) -> Vec<&'static str> {
         let Some(p) = self.kin.partition() else {
             return Vec::new();
         };
         let info = self.info;
-        let (n, mh, nnh) = (info.nq(), info.nh(), info.nnh());
+        let (mh, nnh) = (info.nh(), info.nnh());
         let names = p
             .redundant_rows()
             .iter()
             .map(|&i| info.holonomic[i].name)
             .collect();
         let r = p.holonomic_rows().len();
-        match self.form {
-            Formulation::Partitioning => self.dim = (2 * (n - r) - nnh).max(1),
-            Formulation::Projection => {
-                self.rows.clear();
-                self.rows.extend_from_slice(p.holonomic_rows());
-                self.rows.extend(mh..mh + nnh);
-                self.rows_h = r;
-                if r != mh {
-                    self.lu_h = DenseLu::new(r, 1);
-                    self.lu_v = DenseLu::new(r + nnh, 1);
-                }
+        if !matches!(self.form, Formulation::Baumgarte { .. }) {
+            self.rows.clear();
+            self.rows.extend_from_slice(p.holonomic_rows());
+            self.rows.extend(mh..mh + nnh);
+            self.rows_h = r;
+            if r != mh {
+                self.lu_h = DenseLu::new(r, 1);
+                self.lu_v = DenseLu::new(r + nnh, 1);
+                self.chart.resize(r);
             }
-            Formulation::Baumgarte { .. } => {}
         }
         names
     }
 
-    /// Copies the index sets of the current partition (no allocation: the capacity is
-    /// `n`); returns whether they changed.
-    pub fn update_indices(&mut self) -> bool {
-        let p = self
-            .kin
-            .partition()
-            .expect("partitioning keeps a partition");
-        let (eta, ind) = (p.dependent_velocity(), p.independent());
-        if !self.coords.is_empty() && self.coords.len() != eta.len() + ind.len() {
-            // The rank of C_q changed (a redundant row became independent or the
-            // reverse): the state would change dimension. The driver reports it.
-            self.rank_changed = true;
-            return false;
-        }
-        let same = self.coords.len() == eta.len() + ind.len()
-            && self.coords[..eta.len()] == *eta
-            && self.coords[eta.len()..] == *ind;
-        if same {
-            return false;
-        }
-        self.coords.clear();
-        self.coords.extend_from_slice(p.dependent_velocity());
-        self.coords.extend_from_slice(p.independent());
-        self.gamma.clear();
-        self.gamma.extend_from_slice(p.independent());
-        true
-    }
-
     /// Partitioning: takes the current full state (consistent, at `t`) as the last
-    /// accepted one: the reference of the branch check and the state an evaluation
-    /// that failed recoverably falls back to. Runs K2 for the sign of $\det J_d$ under
-    /// the current partition (so call it again after a re-partition).
-    pub fn accept(&mut self, t: f64) -> Result<(), Error> {
+    /// accepted one: the anchor of the chart of the next step and the reference of the
+    /// branch check.
+    pub fn accept(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if self.form != Formulation::Partitioning {
             return Ok(());
         }
-        self.factorizations += 1;
-        self.kin
-            .velocity(self.mech, &mut self.ws, t, &self.q, &mut self.qd)?;
-        self.q_acc.copy_from_slice(&self.q);
-        self.qd_acc.copy_from_slice(&self.qd);
-        self.t_acc = t;
-        self.t_state = t;
-        self.sign_acc = self.kin.dependent_sign();
         self.retries = 0;
-        self.anchored = true;
+        self.q_acc.copy_from_slice(&self.q);
+        if self.rows_h == 0 {
+            return Ok(());
+        }
+        self.ws
+            .eval_jacobian(self.mech, t, &self.q)
+            .map_err(SimErrorKind::from_eval)?;
+        self.factorizations += 1;
+        let ratio = self
+            .chart
+            .anchor(&self.ws, &self.q, &self.rows[..self.rows_h]);
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Projection,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
         Ok(())
     }
 
     /// Writes the state vector of the current full state `q`, `qd` into `y`.
     pub fn gather(&self, y: &mut [f64]) {
-        match self.form {
-            Formulation::Partitioning => {
-                y.fill(0.0);
-                let np = self.coords.len();
-                for (k, &j) in self.coords.iter().enumerate() {
-                    y[k] = self.q[j];
-                }
-                for (k, &j) in self.gamma.iter().enumerate() {
-                    y[np + k] = self.qd[j];
-                }
-            }
-            _ => {
-                let n = self.q.len();
-                y[..n].copy_from_slice(&self.q);
-                y[n..].copy_from_slice(&self.qd);
-            }
-        }
+        let n = self.q.len();
+        y[..n].copy_from_slice(&self.q);
+        y[n..].copy_from_slice(&self.qd);
     }
 
-    /// Fills the full `q`, `qd` from the state `y` at `t` (K1 and K2 for partitioning).
-    pub fn reconstruct(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
-        match self.form {
-            Formulation::Partitioning => {
-                let np = self.coords.len();
-                // The base of the guess is the last accepted state (once there is one):
-                // a state of the motion, so that the predictor errs by O(dt²) and the
-                // branch check of `rhs` can compare the correction with the move.
-                // Chaining from the last evaluation (a stage of a trial step, maybe a
-                // rejected one) gives errors of the order of the move itself.
-                if self.anchored {
-                    self.q.copy_from_slice(&self.q_acc);
-                    self.qd.copy_from_slice(&self.qd_acc);
-                    self.t_state = self.t_acc;
+    /// Fills the full `q`, `qd` from the state `y` at `t`: for partitioning, the point
+    /// of the manifold the current chart assigns to `y`, to the integrator's tolerance
+    /// (see [`Chart`]).
+    pub fn reconstruct(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        let n = self.q.len();
+        if self.form != Formulation::Partitioning {
+            self.q.copy_from_slice(&y[..n]);
+            self.qd.copy_from_slice(&y[n..]);
+            return Ok(());
+        }
+        if self.cached == Some(t) && self.y_cached == y {
+            return Ok(());
+        }
+        self.cached = None;
+        self.q.copy_from_slice(&y[..n]);
+        self.qd.copy_from_slice(&y[n..]);
+        if self.rows_h > 0 {
+            let rows = &self.rows[..self.rows_h];
+            match self
+                .chart
+                .correct(self.mech, &mut self.ws, t, &mut self.q, rows)
+            {
+                Ok(iterations) => self.newton_iterations += iterations as u64,
+                Err(ChartFailure::Eval(e)) => return Err(SimErrorKind::from_eval(e)),
+                Err(ChartFailure::Newton {
+                    iterations,
+                    residual,
+                }) => {
+                    self.newton_iterations += iterations as u64;
+                    let bound = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
+                    return Err(SimErrorKind::NewtonFailed {
+                        t,
+                        iterations,
+                        residual,
+                        constraints: self.violated(bound),
+                    });
                 }
-                let mut moved = 0.0_f64;
-                for (k, &j) in self.coords.iter().enumerate() {
-                    moved = moved.max((y[k] - self.q[j]).abs());
-                    self.q[j] = y[k];
-                }
-                // First-order predictor for the guess of β: the base's β moved along
-                // its velocity. Without it, fast mechanisms (Andrews) and long steps
-                // let Newton converge to another assembly branch.
-                let dt = t - self.t_state;
-                if let Some(p) = self.kin.partition() {
-                    for &j in p.dependent() {
-                        self.q[j] += self.qd[j] * dt;
-                        moved = moved.max((self.qd[j] * dt).abs());
-                    }
-                }
-                self.guess.copy_from_slice(&self.q);
-                let r = self.kin.position(self.mech, &mut self.ws, t, &mut self.q);
-                self.correction = self.kin.partition().map_or(0.0, |p| {
-                    p.dependent()
-                        .iter()
-                        .fold(0.0_f64, |a, &j| a.max((self.q[j] - self.guess[j]).abs()))
-                });
-                self.moved = moved;
-                let iterations = self.kin.residual_history().len().saturating_sub(1) as u64;
-                self.newton_iterations += iterations;
-                self.factorizations += iterations;
-                if let Err(e) = r {
-                    self.note_failure(&e);
-                    return Err(e.into());
-                }
-                for (k, &j) in self.gamma.iter().enumerate() {
-                    self.qd[j] = y[np + k];
-                }
-                self.factorizations += 1;
-                if let Err(e) = self
-                    .kin
-                    .velocity(self.mech, &mut self.ws, t, &self.q, &mut self.qd)
-                {
-                    self.note_failure(&e);
-                    return Err(e.into());
-                }
-                self.t_state = t;
             }
-            _ => {
-                let n = self.q.len();
-                self.q.copy_from_slice(&y[..n]);
-                self.qd.copy_from_slice(&y[n..]);
+            // A correction larger than the move from the last accepted state: Newton
+            // went to another intersection of the normal space with the manifold.
+            let (mut moved, mut correction) = (0.0_f64, 0.0_f64);
+            for ((&yj, &qj), &aj) in y.iter().zip(&self.q).zip(&self.q_acc) {
+                moved = moved.max((yj - aj).abs());
+                correction = correction.max((qj - yj).abs());
+            }
+            let scale = inf_norm(&self.q);
+            let floor = BRANCH_FLOOR * (1.0 + scale) + self.chart.tolerance(scale);
+            if correction > moved + floor {
+                return Err(SimErrorKind::NewtonFailed {
+                    t,
+                    iterations: 0,
+                    residual: correction,
+                    constraints: Vec::new(),
+                });
             }
         }
+        self.project_velocities(t)?;
+        self.cached = Some(t);
+        self.y_cached.copy_from_slice(y);
         Ok(())
     }
 
-    /// Records the holonomic constraints not met by the last iterate of a failed K1.
-    fn note_failure(&mut self, e: &KinematicsError) {
-        if let KinematicsError::SingularDependent { .. }
-        | KinematicsError::SingularVelocity { .. } = e
-        {
-            let tol = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
-            self.failure_constraints = self
-                .ws
-                .constraints()
-                .iter()
-                .zip(self.info.holonomic)
-                .filter(|(c, _)| c.is_nan() || c.abs() > tol)
-                .map(|(_, s)| s.name)
-                .collect();
+    /// [`reconstruct`](Self::reconstruct) for a state the driver keeps (accepted or
+    /// output): for partitioning, the point of the chart (when the integrator has just
+    /// evaluated there, otherwise `y`) polished by [`project`](Self::project), so that
+    /// the constraints hold to the simulation's Newton tolerance (the polish is below
+    /// the integrator's tolerance, the derivatives the integrator keeps stay valid).
+    pub fn reconstruct_exact(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        if self.form != Formulation::Partitioning {
+            return self.reconstruct(t, y);
         }
+        if self.cached != Some(t) || self.y_cached != y {
+            let n = self.q.len();
+            self.q.copy_from_slice(&y[..n]);
+            self.qd.copy_from_slice(&y[n..]);
+        }
+        self.cached = None;
+        self.project(t)
     }
 
     /// $\ddot q$ and $\lambda$ at the full state (with the stabilization term for
     /// Baumgarte).
-    pub fn accelerations(&mut self, t: f64) -> Result<(), Error> {
+    pub fn accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let shift = if let Formulation::Baumgarte { alpha, beta } = self.form {
-            self.velocity_terms(t)?;
+            self.velocity_terms(t).map_err(SimErrorKind::from_eval)?;
             let mh = self.info.nh();
             let c = self.ws.constraints();
             for (i, s) in self.shift.iter_mut().enumerate() {
@@ -351,16 +291,18 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             None
         };
         self.factorizations += 1;
-        self.dynamics.accelerations_shifted(
-            self.mech,
-            &mut self.ws,
-            t,
-            &self.q,
-            &self.qd,
-            shift,
-            &mut self.qdd,
-            &mut self.lambda,
-        )?;
+        self.dynamics
+            .accelerations_shifted(
+                self.mech,
+                &mut self.ws,
+                t,
+                &self.q,
+                &self.qd,
+                shift,
+                &mut self.qdd,
+                &mut self.lambda,
+            )
+            .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
         // Reported once, as first identified: which rows of a dependent set the
         // pivoting names can change along the motion, the redundancy does not.
         if self.redundant.is_empty() {
@@ -405,7 +347,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
     /// $\dot q \leftarrow \dot q - J^\mathsf{T}(J J^\mathsf{T})^{-1}(J\dot q + [C_t; g])$.
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let info = self.info;
-        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        let (n, mh) = (info.nq(), info.nh());
         let newton = self.kin.params().newton;
         let eval = |e: EvalError| SimErrorKind::from_eval(e);
         if mh > 0 {
@@ -429,7 +371,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 }
                 self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
                 let rows = &self.rows[..self.rows_h];
-                let ratio = gram(&mut self.lu_h, &self.ws.jacobian, rows, n);
+                let ratio = gram_factor(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
@@ -453,29 +395,40 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 self.factorizations += 1;
             }
         }
-        if m > 0 {
-            self.velocity_terms(t).map_err(eval)?;
-            self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
-            let rows = &self.rows[..];
-            let ratio = gram(&mut self.lu_v, &self.ws.jacobian, rows, n);
-            self.factorizations += 1;
-            if ratio.is_nan() || ratio <= SINGULAR_RATIO {
-                return Err(SimErrorKind::Singular {
-                    t,
-                    matrix: SingularMatrix::Projection,
-                    ratio,
-                    constraints: Vec::new(),
-                });
-            }
-            for (mu, &i) in self.mu.iter_mut().zip(rows) {
-                *mu = self.vel[i];
-            }
-            self.lu_v.solve_vec(&mut self.mu[..rows.len()]);
-            for (&i, mu) in rows.iter().zip(&self.mu) {
-                let row = &self.ws.jacobian[i * n..(i + 1) * n];
-                for (v, a) in self.qd.iter_mut().zip(row) {
-                    *v -= a * mu;
-                }
+        self.project_velocities(t)
+    }
+
+    /// The orthogonal projection of the velocities onto the velocity constraints at
+    /// the current positions,
+    /// $\dot q \leftarrow \dot q - J^\mathsf{T}(J J^\mathsf{T})^{-1}(J\dot q + [C_t; g])$
+    /// (the rows `rows`).
+    fn project_velocities(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let n = self.info.nq();
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        let eval = SimErrorKind::from_eval;
+        self.velocity_terms(t).map_err(eval)?;
+        self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+        let rows = &self.rows[..];
+        let ratio = gram_factor(&mut self.lu_v, &self.ws.jacobian, rows, n);
+        self.factorizations += 1;
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Projection,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
+        for (mu, &i) in self.mu.iter_mut().zip(rows) {
+            *mu = self.vel[i];
+        }
+        self.lu_v.solve_vec(&mut self.mu[..rows.len()]);
+        for (&i, mu) in rows.iter().zip(&self.mu) {
+            let row = &self.ws.jacobian[i * n..(i + 1) * n];
+            for (v, a) in self.qd.iter_mut().zip(row) {
+                *v -= a * mu;
             }
         }
         Ok(())
@@ -490,110 +443,33 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .map(|(_, s)| s.name)
             .collect()
     }
-
-    fn rhs_inner(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Error> {
-        self.reconstruct(t, y)?;
-        self.rhs_inner_full(t, dy)
-    }
-
-    /// $\dot y$ from the full state already reconstructed at `t`.
-    fn rhs_inner_full(&mut self, t: f64, dy: &mut [f64]) -> Result<(), Error> {
-        self.accelerations(t)?;
-        match self.form {
-            Formulation::Partitioning => {
-                dy.fill(0.0);
-                let np = self.coords.len();
-                for (k, &j) in self.coords.iter().enumerate() {
-                    dy[k] = self.qd[j];
-                }
-                for (k, &j) in self.gamma.iter().enumerate() {
-                    dy[np + k] = self.qdd[j];
-                }
-            }
-            _ => {
-                let n = self.q.len();
-                dy[..n].copy_from_slice(&self.qd);
-                dy[n..].copy_from_slice(&self.qdd);
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
-/// into `lu`, factors it and returns the pivot ratio.
-fn gram(lu: &mut DenseLu, a: &[f64], rows: &[usize], n: usize) -> f64 {
-    {
-        let mut g = lu.matrix_mut();
-        for (i, &ri) in rows.iter().enumerate() {
-            let ri = &a[ri * n..(ri + 1) * n];
-            for (k, &rk) in rows[..=i].iter().enumerate() {
-                let rk = &a[rk * n..(rk + 1) * n];
-                let v: f64 = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
-                g[(i, k)] = v;
-                g[(k, i)] = v;
-            }
-        }
-    }
-    lu.factor().ratio()
 }
 
 impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
     fn dim(&self) -> usize {
-        self.dim
+        2 * self.info.nq()
     }
 
-    /// Partitioning: a kinematic failure of K1 or K2 (Newton diverged, a singular
-    /// dependent block, or a jump to another solution branch) comes from a guess
-    /// extrapolated too far, so it is [recoverable](RhsError::recoverable).
-    ///
-    /// K1 has jumped branches when
-    /// - the sign of $\det J_d$ differs from the last accepted state's (the mirror
-    ///   assembly, see [`Kinematics::dependent_sign`]), or
-    /// - Newton corrected the guess by more than the largest move of a coordinate
-    ///   from the base state to the guess (plus [`BRANCH_FLOOR`]): along the motion
-    ///   the first-order predictor moves by $O(h)$ and errs by $O(h^2)$, so a larger
-    ///   correction means the step is outside the predictor's range, as when an angle
-    ///   lands on another turn ($\beta + 2\pi k$: same sign, same configuration, a
-    ///   discontinuous state).
-    ///
-    /// The integrator then retries a shorter step
-    /// from the last accepted state, which also becomes the base of the next guess.
-    /// After [`MAX_RETRIES`] such failures in a row the failure stops the integrator
-    /// and the driver re-partitions.
+    /// Partitioning: a failure of the chart's Newton iteration (it diverged, or jumped
+    /// to another intersection of the normal space with the manifold: a correction
+    /// larger than the move from the last accepted state, since along the motion the
+    /// prediction errs by the local error only) or a singular projection comes from a
+    /// step too long for the chart, so it is [recoverable](RhsError::recoverable): the
+    /// integrator retries a shorter step. After [`MAX_RETRIES`] such failures in a row
+    /// the failure ends the run.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        if self.form != Formulation::Partitioning {
-            return self.rhs_inner(t, y, dy).map_err(RhsError::new);
-        }
-        let r = self.reconstruct(t, y).and_then(|()| {
-            let sign = self.kin.dependent_sign();
-            let floor = BRANCH_FLOOR * (1.0 + inf_norm(&self.q));
-            if (self.sign_acc != 0.0 && sign != self.sign_acc)
-                || self.correction > self.moved + floor
-            {
-                let history = self.kin.residual_history();
-                return Err(Error::Kinematics(KinematicsError::BranchSwitch {
-                    t,
-                    iterations: history.len().saturating_sub(1),
-                    residual: history.last().copied().unwrap_or(0.0),
-                }));
-            }
-            Ok(())
-        });
-        let r = r.and_then(|()| self.rhs_inner_full(t, dy));
+        let n = self.q.len();
+        let r = self.reconstruct(t, y).and_then(|()| self.accelerations(t));
         match r {
-            Ok(()) => Ok(()),
-            Err(
-                e @ Error::Kinematics(
-                    KinematicsError::NewtonFailed { .. }
-                    | KinematicsError::BranchSwitch { .. }
-                    | KinematicsError::SingularDependent { .. }
-                    | KinematicsError::SingularVelocity { .. },
-                ),
-            ) => {
-                self.q.copy_from_slice(&self.q_acc);
-                self.qd.copy_from_slice(&self.qd_acc);
-                self.t_state = self.t_acc;
+            Ok(()) => {
+                dy[..n].copy_from_slice(&self.qd);
+                dy[n..].copy_from_slice(&self.qdd);
+                Ok(())
+            }
+            Err(e @ (SimErrorKind::NewtonFailed { .. } | SimErrorKind::Singular { .. }))
+                if self.form == Formulation::Partitioning =>
+            {
+                self.cached = None;
                 self.retries += 1;
                 if self.retries <= MAX_RETRIES {
                     Err(RhsError::recoverable(e))
@@ -601,7 +477,10 @@ impl<M: Mechanism + ?Sized> OdeSystem for MechSystem<'_, M> {
                     Err(RhsError::new(e))
                 }
             }
-            Err(e) => Err(RhsError::new(e)),
+            Err(e) => {
+                self.cached = None;
+                Err(RhsError::new(e))
+            }
         }
     }
 }

@@ -9,6 +9,7 @@ mod andrews;
 mod exact;
 mod faults;
 mod models;
+mod partitioning;
 mod pendulum;
 mod redundant;
 mod robustness;

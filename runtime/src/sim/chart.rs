@@ -1,0 +1,201 @@
+//! Local tangent-space coordinates for [`Formulation::Partitioning`](super::Formulation).
+//!
+//! Input: an *anchor* $q_a$ on the constraint manifold (the last accepted state) with
+//! the independent rows $N = C_{q,R}(q_a)$ of its holonomic Jacobian, and a position
+//! $\tilde q$ predicted by the integrator near it. Output: the point of the manifold
+//! with the same tangential part,
+//! $$q = \tilde q + N^\mathsf{T}\mu,\qquad C_R(q, t) = 0,$$
+//! found by Newton on the $r$ normal coordinates $\mu$ (the dependent coordinates of the
+//! chart). The chart is the graph of the manifold over its tangent space at $q_a$, an
+//! orthonormal-quality partition: its conditioning is that of $N N^\mathsf{T}$, the best
+//! any choice of dependent coordinates can have, and it is renewed at every step.
+//!
+//! **Newton.** The iteration starts from the integrator's own prediction (off the
+//! manifold by the local error) and is a chord iteration with the factorization of
+//! $N N^\mathsf{T}$ made at the anchor, so an evaluation factors nothing. It converges
+//! linearly with a rate proportional to the distance from the anchor; the rate per unit
+//! distance is measured whenever two updates are taken and carried to the next
+//! evaluations. The iteration stops when the estimated remaining error
+//! $\frac{\rho}{1-\rho}\lVert\Delta q\rVert$ is below [`KAPPA`] in the integrator's
+//! weights $\text{atol} + \text{rtol}\,|q_j|$ (as the Newton iterations of implicit
+//! integrators do), or at round-off. One update per evaluation is the norm.
+//!
+//! Invariant: no allocation after [`Chart::new`] (except when building an error).
+
+use crate::linalg::dense::{gram_factor, DenseLu};
+use crate::linalg::inf_norm;
+use crate::workspace::{EvalError, Workspace};
+use crate::Mechanism;
+
+/// Fraction of the integrator's tolerance the Newton iteration leaves as error.
+///
+/// Implicit integrators stop their Newton iterations a few hundredths of the tolerance
+/// away from the solution (Hairer's `RADAU5`: 0.03). Here the left error moves the
+/// evaluated state off the manifold by that much, and the right-hand side with it.
+pub(crate) const KAPPA: f64 = 0.03;
+
+/// Most chord updates per evaluation before it is called a failure.
+const MAX_ITERATIONS: usize = 12;
+
+/// A contraction rate at or above which the chord iteration has failed.
+const DIVERGENCE: f64 = 0.9;
+
+/// Contraction rate assumed when none has been measured: forces a second update,
+/// which measures it.
+const UNKNOWN_RATE: f64 = 0.5;
+
+/// Pivot ratio below which $N N^\mathsf{T}$ counts as singular.
+pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
+
+/// The outcome of a failed correction.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum ChartFailure {
+    /// The model's functions failed.
+    Eval(EvalError),
+    /// The chord iteration diverged or did not reach the tolerance.
+    Newton {
+        /// Updates taken.
+        iterations: usize,
+        /// $\lVert C\rVert_\infty$ at the last iterate.
+        residual: f64,
+    },
+}
+
+impl From<EvalError> for ChartFailure {
+    fn from(e: EvalError) -> Self {
+        Self::Eval(e)
+    }
+}
+
+/// A chart anchored at an accepted state, with the Newton scratch.
+#[derive(Debug)]
+pub(crate) struct Chart {
+    /// The anchor $q_a$.
+    anchor: Vec<f64>,
+    /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows`.
+    normals: Vec<f64>,
+    /// $N N^\mathsf{T}$, factored.
+    gram: DenseLu,
+    /// Normal coordinates of the current update.
+    mu: Vec<f64>,
+    /// Measured contraction rate per unit distance from the anchor.
+    rate_per_distance: Option<f64>,
+    rtol: f64,
+    atol: f64,
+}
+
+impl Chart {
+    /// Scratch for a model with `n` coordinates and `m` constraint rows, of which `r`
+    /// independent holonomic ones, for the integrator's tolerances `rtol`, `atol`.
+    pub fn new(n: usize, m: usize, r: usize, rtol: f64, atol: f64) -> Self {
+        Self {
+            anchor: vec![0.0; n],
+            normals: vec![0.0; m * n],
+            gram: DenseLu::new(r, 1),
+            mu: vec![0.0; r],
+            rate_per_distance: None,
+            rtol,
+            atol,
+        }
+    }
+
+    /// Resizes for `r` rows (after assembly dropped redundant ones; allocates).
+    pub fn resize(&mut self, r: usize) {
+        if self.mu.len() != r {
+            self.gram = DenseLu::new(r, 1);
+            self.mu = vec![0.0; r];
+        }
+    }
+
+    /// The integrator's tolerance $\text{atol} + \text{rtol}\,x$ for a value of size `x`.
+    pub fn tolerance(&self, x: f64) -> f64 {
+        self.atol + self.rtol * x.abs()
+    }
+
+    /// Anchors the chart at `q` (on the manifold), whose dense $J$ is in `ws` (its rows
+    /// `rows` are taken); returns the pivot ratio of $N N^\mathsf{T}$.
+    pub fn anchor(&mut self, ws: &Workspace, q: &[f64], rows: &[usize]) -> f64 {
+        self.anchor.copy_from_slice(q);
+        self.normals.copy_from_slice(ws.jacobian());
+        gram_factor(&mut self.gram, &self.normals, rows, q.len())
+    }
+
+    /// Moves `q` along the anchor's normals onto $C_R(q, t) = 0$, to the integrator's
+    /// tolerance (see the module docs); returns the number of updates. `rows` are the
+    /// holonomic rows of the chart.
+    pub fn correct<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+        rows: &[usize],
+    ) -> Result<usize, ChartFailure> {
+        let n = q.len();
+        let distance = q
+            .iter()
+            .zip(&self.anchor)
+            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        let mut rate = self
+            .rate_per_distance
+            .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
+        let floor = 8.0 * f64::EPSILON * (1.0 + inf_norm(q));
+        let mut previous: Option<f64> = None;
+        for iteration in 0..=MAX_ITERATIONS {
+            ws.eval_constraints(mech, t, q)?;
+            let c = ws.constraints();
+            let residual = rows.iter().fold(0.0_f64, |a, &i| a.max(c[i].abs()));
+            if !residual.is_finite() {
+                return Err(ChartFailure::Newton {
+                    iterations: iteration,
+                    residual,
+                });
+            }
+            if iteration == 0 && residual <= floor {
+                return Ok(0);
+            }
+            if iteration == MAX_ITERATIONS {
+                return Err(ChartFailure::Newton {
+                    iterations: iteration,
+                    residual,
+                });
+            }
+            for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                *mu = c[i];
+            }
+            self.gram.solve_vec(&mut self.mu);
+            let mut step = 0.0_f64;
+            let mut weighted = 0.0_f64;
+            for (j, qj) in q.iter_mut().enumerate() {
+                let dq: f64 = -self
+                    .mu
+                    .iter()
+                    .zip(rows)
+                    .map(|(mu, &i)| self.normals[i * n + j] * mu)
+                    .sum::<f64>();
+                *qj += dq;
+                step = step.max(dq.abs());
+                weighted = weighted.max(dq.abs() / (self.atol + self.rtol * qj.abs()));
+            }
+            if let Some(p) = previous {
+                let measured = weighted / p;
+                if measured.is_nan() || measured >= DIVERGENCE {
+                    return Err(ChartFailure::Newton {
+                        iterations: iteration + 1,
+                        residual,
+                    });
+                }
+                rate = measured;
+                // A rate measured on updates at round-off is noise.
+                if step > 100.0 * floor && distance > 0.0 {
+                    self.rate_per_distance = Some(measured / distance);
+                }
+            }
+            if step <= floor || rate / (1.0 - rate) * weighted <= KAPPA {
+                return Ok(iteration + 1);
+            }
+            previous = Some(weighted);
+        }
+        unreachable!("the loop returns at MAX_ITERATIONS")
+    }
+}
