@@ -234,9 +234,15 @@ fn simulate_failure_reports_the_error_and_the_partial_run() {
         .map(String::as_str)
         .collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["kind", "message", "t"]);
-    assert_eq!(v["error"]["kind"], "singular");
+    assert_eq!(keys, ["kind", "message", "stopped_at", "t"]);
+    assert_eq!(v["error"]["kind"], "singular_mass");
     assert_eq!(v["error"]["t"], 0.0);
+    // Nothing consistent was computed: no last state.
+    assert!(v["error"]["stopped_at"].is_null());
+    assert!(v["final"].is_null());
+    // The massless coordinates are named.
+    let message = v["error"]["message"].as_str().unwrap();
+    assert!(message.contains("coordinates involved"), "{message}");
 }
 
 #[test]
@@ -284,12 +290,32 @@ fn simulate_writes_csv_and_plot() {
 fn simulate_holds_prescribed_initial_values() {
     // x prescribed; y follows from the link (y = -sqrt(1 - 0.36)), started below.
     let out = pfaff(&[
-        "simulate", "pendulum", "--t-end", "0.5", "--q0", "x=0.6", "--q0", "y=-0.9", "--set",
-        "l=1", "--json",
+        "simulate", "pendulum", "--t-end", "0.5", "--q0", "x=0.6", "--set", "l=1", "--json",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
     assert!(v["final"]["q"]["x"].as_f64().unwrap().abs() < 0.6);
+}
+
+#[test]
+fn simulate_takes_a_full_consistent_state_and_names_what_an_inconsistent_one_violates() {
+    // x² + y² = 1 and x ẋ + y ẏ = 0: kept as given, so the initial energy is
+    // g y + ½(ẋ² + ẏ²) = −7.848 + 1.125.
+    let out = pfaff(&[
+        "simulate", "pendulum", "--t-end", "0.5", "--q0", "x=0.6", "--q0", "y=-0.8", "--qd0",
+        "x=1.2", "--qd0", "y=0.9", "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let e0 = v["energy"]["initial"].as_f64().unwrap();
+    assert!((e0 + 6.723).abs() < 1e-12, "{e0}");
+    // 0.36 + 0.81 − 1 = 0.17 off the link.
+    let out = pfaff(&[
+        "simulate", "pendulum", "--t-end", "0.5", "--q0", "x=0.6", "--q0", "y=-0.9",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("`rod` by 1.700e-1"), "{err}");
 }
 
 #[test]

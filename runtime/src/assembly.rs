@@ -9,11 +9,65 @@
 //! $\gamma$ (an error names the coordinate and the constraints that make this
 //! impossible); Newton K1 on $\beta$; the velocity solve K2 with the non-prescribed
 //! independent velocities taken from the guess.
+//!
+//! **A full state.** When every coordinate is prescribed there is nothing to solve: the
+//! values are checked against the constraints instead, each row $i$ within
+//! [`CONSISTENCY_TOLERANCE`] of its scale,
+//! $|C_i| \le \varepsilon\,(1 + \lVert q\rVert_\infty)\max_j |\partial C_i/\partial q_j|$
+//! (the coordinates are within a relative $\varepsilon$ of meeting the row), and kept
+//! as given; a violation is an [`AssemblyError::Inconsistent`] naming every violated
+//! constraint with its residual. Likewise when every velocity is prescribed, with
+//! $|J_i\dot q + c_i| \le \varepsilon\,(\sum_j |J_{ij}\dot q_j| + |c_i|)$ (up to
+//! round-off when all terms vanish).
 
 use crate::kinematics::{Kinematics, KinematicsError, NewtonStats};
 use crate::partition::{PartitionError, Preferences};
 use crate::workspace::{check_state, EvalError, Workspace};
 use crate::Mechanism;
+
+/// Relative tolerance $\varepsilon$ of the consistency check of a fully prescribed
+/// state (see the module docs): values typed with about ten significant digits pass, a
+/// state off the constraints by more than a hundred-millionth of its size does not.
+pub const CONSISTENCY_TOLERANCE: f64 = 1e-8;
+
+/// Which level of a fully prescribed state violates the constraints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateLevel {
+    /// The coordinates $q$: $C(q, t) = 0$.
+    Positions,
+    /// The velocities $\dot q$: $C_q\dot q + C_t = 0$, $G\dot q + g = 0$.
+    Velocities,
+}
+
+impl std::fmt::Display for StateLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Positions => "coordinates",
+            Self::Velocities => "velocities",
+        })
+    }
+}
+
+/// A constraint violated by a fully prescribed state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Violation {
+    /// The constraint's name.
+    pub constraint: &'static str,
+    /// Its residual ($C_i$, or $J_i\dot q + c_i$).
+    pub residual: f64,
+    /// The largest residual the check accepted for it.
+    pub tolerance: f64,
+}
+
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "`{}` by {:.3e} (tolerance {:.1e})",
+            self.constraint, self.residual, self.tolerance
+        )
+    }
+}
 
 /// Prescribed values by coordinate name.
 #[derive(Clone, Copy, Debug, Default)]
@@ -35,6 +89,28 @@ pub struct AssemblyReport {
     pub velocity_correction: f64,
     /// $\lVert [C_q\dot q + C_t;\ G\dot q + g]\rVert_\infty$ at the result.
     pub velocity_residual: f64,
+}
+
+/// A declared initial velocity that the constraints determine from the others (see
+/// [`Kinematics::assemble_declared`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverriddenVelocity {
+    /// The coordinate.
+    pub coordinate: &'static str,
+    /// The velocity declared.
+    pub declared: f64,
+    /// The velocity the constraints gave it.
+    pub used: f64,
+}
+
+impl std::fmt::Display for OverriddenVelocity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the declared initial velocity of `{}` ({}) is determined by the constraints from the others: {} was used",
+            self.coordinate, self.declared, self.used
+        )
+    }
 }
 
 /// Errors of assembly.
@@ -60,9 +136,25 @@ pub enum AssemblyError {
     /// Newton could not meet the constraints from the guess, or a solve failed.
     #[error("cannot assemble from the guess: {0}")]
     Kinematics(#[from] KinematicsError),
+    /// Every coordinate (or velocity) is prescribed and the values violate the
+    /// constraints.
+    #[error("the prescribed {level} violate the constraints: {}", list(.violated))]
+    Inconsistent {
+        /// Coordinates or velocities.
+        level: StateLevel,
+        /// The violated constraints, in row order.
+        violated: Vec<Violation>,
+    },
     /// Evaluation failed.
     #[error(transparent)]
     Eval(#[from] EvalError),
+}
+
+fn list(v: &[Violation]) -> String {
+    v.iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn resolve(
@@ -138,8 +230,22 @@ impl Kinematics {
             qd[i] = v;
         }
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
-        let pos_idx: Vec<usize> = pos.iter().map(|p| p.0).collect();
-        let vel_idx: Vec<usize> = vel.iter().map(|p| p.0).collect();
+        let n = info.nq();
+        // A full state is checked, not solved for (module docs).
+        let (all_q, all_qd) = (pos.len() == n, vel.len() == n);
+        if all_q {
+            check_positions(mech, ws, t, q)?;
+        }
+        let pos_idx: Vec<usize> = if all_q {
+            Vec::new()
+        } else {
+            pos.iter().map(|p| p.0).collect()
+        };
+        let vel_idx: Vec<usize> = if all_qd {
+            Vec::new()
+        } else {
+            vel.iter().map(|p| p.0).collect()
+        };
         let previous = self.partition.take();
         let prefs = Preferences {
             coordinates: &pos_idx,
@@ -149,8 +255,21 @@ impl Kinematics {
             self.partition = previous;
             return Err(e.into());
         }
-        let newton = self.position(mech, ws, t, q)?;
-        self.velocity(mech, ws, t, q, qd)?;
+        let newton = if all_q {
+            ws.eval_constraints(mech, t, q)?;
+            NewtonStats {
+                iterations: 0,
+                residual: crate::linalg::inf_norm(ws.constraints()),
+                step: 0.0,
+            }
+        } else {
+            self.position(mech, ws, t, q)?
+        };
+        if all_qd {
+            check_velocities(mech, ws, t, q, qd)?;
+        } else {
+            self.velocity(mech, ws, t, q, qd)?;
+        }
         let velocity_residual = velocity_residual(ws, mech, t, q, qd)?;
         let diff = |a: &[f64], b: &[f64]| {
             a.iter()
@@ -162,6 +281,162 @@ impl Kinematics {
             position_correction: diff(q, &q0),
             velocity_correction: diff(qd, &qd0),
             velocity_residual,
+        })
+    }
+}
+
+impl Kinematics {
+    /// [`assemble`](Self::assemble), also holding the non-zero velocities of the guess
+    /// (a model's declared `qd0`) where the constraints allow it, and reporting the
+    /// ones they determine from the others with the value used. Without this, K2 keeps
+    /// the velocities of whichever coordinates Algorithm P leaves independent, and a
+    /// declared velocity of a dependent coordinate is silently replaced (a model `x`
+    /// with `qd0: 1` tied to `y` by `y - x = 0` would start at rest).
+    ///
+    /// Greedy: after the plain assembly, each declared velocity that it changed is
+    /// added to the prescription if the assembly still succeeds with it, in the order
+    /// of the coordinates; the prescription's own values always come first.
+    ///
+    /// # Errors
+    /// As [`assemble`](Self::assemble) with `prescription` alone.
+    pub fn assemble_declared<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &mut Workspace,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        prescription: &Prescription<'_>,
+    ) -> Result<(AssemblyReport, Vec<OverriddenVelocity>), AssemblyError> {
+        let info = ws.info();
+        check_state(info, t, q, Some(qd))?;
+        let declared: Vec<(&'static str, f64)> = info
+            .coordinates
+            .iter()
+            .zip(qd.iter())
+            .filter(|&(c, &v)| v != 0.0 && !prescription.velocities.iter().any(|g| g.0 == c.name))
+            .map(|(c, &v)| (c.name, v))
+            .collect();
+        let (q0, qd0) = (q.to_vec(), qd.to_vec());
+        self.assemble(mech, ws, t, q, qd, prescription)?;
+        let changed = |qd: &[f64], (name, v): (&'static str, f64)| {
+            let i = info
+                .coordinate_index(name)
+                .expect("a coordinate of the model");
+            ((qd[i] - v).abs() > 1e-9 * v.abs()).then_some(OverriddenVelocity {
+                coordinate: name,
+                declared: v,
+                used: qd[i],
+            })
+        };
+        let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
+        // The velocities of the last successful assembly.
+        let mut assembled = qd.to_vec();
+        for &d in &declared {
+            if changed(&assembled, d).is_none() {
+                continue;
+            }
+            velocities.push(d);
+            let held = Prescription {
+                coordinates: prescription.coordinates,
+                velocities: &velocities,
+            };
+            q.copy_from_slice(&q0);
+            qd.copy_from_slice(&qd0);
+            if self.assemble(mech, ws, t, q, qd, &held).is_ok() {
+                assembled.copy_from_slice(qd);
+            } else {
+                velocities.pop();
+            }
+        }
+        // The last trial may have failed: assemble once more with what held, which
+        // leaves its partition current.
+        let held = Prescription {
+            coordinates: prescription.coordinates,
+            velocities: &velocities,
+        };
+        q.copy_from_slice(&q0);
+        qd.copy_from_slice(&qd0);
+        let report = self.assemble(mech, ws, t, q, qd, &held)?;
+        let overridden = declared
+            .into_iter()
+            .filter_map(|d| changed(qd, d))
+            .collect();
+        Ok((report, overridden))
+    }
+}
+
+/// The position check of a full state (module docs).
+fn check_positions<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+) -> Result<(), AssemblyError> {
+    let info = ws.info();
+    let n = info.nq();
+    ws.eval_constraints(mech, t, q)?;
+    ws.eval_jacobian(mech, t, q)?;
+    let size = 1.0 + crate::linalg::inf_norm(q);
+    let violated: Vec<Violation> = (0..info.nh())
+        .filter_map(|i| {
+            let slope = crate::linalg::inf_norm(&ws.jacobian[i * n..(i + 1) * n]);
+            let tolerance = CONSISTENCY_TOLERANCE * size * slope;
+            let residual = ws.c[i];
+            (residual.abs() > tolerance).then_some(Violation {
+                constraint: info.holonomic[i].name,
+                residual,
+                tolerance,
+            })
+        })
+        .collect();
+    if violated.is_empty() {
+        Ok(())
+    } else {
+        Err(AssemblyError::Inconsistent {
+            level: StateLevel::Positions,
+            violated,
+        })
+    }
+}
+
+/// The velocity check of a full state (module docs).
+fn check_velocities<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<(), AssemblyError> {
+    let info = ws.info();
+    let (n, mh) = (info.nq(), info.nh());
+    ws.eval_jacobian(mech, t, q)?;
+    ws.eval_rates(mech, t, q)?;
+    let violated: Vec<Violation> = (0..mh + info.nnh())
+        .filter_map(|i| {
+            let c = if i < mh { ws.ct[i] } else { ws.bias[i - mh] };
+            let row = &ws.jacobian[i * n..(i + 1) * n];
+            let residual = row.iter().zip(qd).map(|(a, b)| a * b).sum::<f64>() + c;
+            let scale = row.iter().zip(qd).map(|(a, b)| (a * b).abs()).sum::<f64>() + c.abs();
+            let tolerance = CONSISTENCY_TOLERANCE * scale + f64::MIN_POSITIVE;
+            let name = if i < mh {
+                info.holonomic[i].name
+            } else {
+                info.nonholonomic[i - mh].name
+            };
+            (residual.abs() > tolerance).then_some(Violation {
+                constraint: name,
+                residual,
+                tolerance,
+            })
+        })
+        .collect();
+    if violated.is_empty() {
+        Ok(())
+    } else {
+        Err(AssemblyError::Inconsistent {
+            level: StateLevel::Velocities,
+            violated,
         })
     }
 }

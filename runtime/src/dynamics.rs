@@ -126,14 +126,18 @@ pub struct AccelerationStats {
 pub enum DynamicsError {
     /// The augmented matrix is singular although $J$ has full rank (or the reduced one
     /// is singular): $M$ is not positive definite on $\ker J$.
-    #[error("augmented system singular at t = {t} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space")]
+    #[error("augmented system singular at t = {t} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", free_list(coordinates))]
     Singular {
         /// Time.
         t: f64,
         /// Rank of $J$.
         rank: usize,
-        /// Smallest / largest pivot.
+        /// Smallest / largest pivot (of the equilibrated matrix).
         ratio: f64,
+        /// Coordinates whose accelerations the equations leave undetermined (the
+        /// unknowns complete pivoting finds no pivot for, a massless coordinate for
+        /// instance).
+        coordinates: Vec<&'static str>,
     },
     /// Redundant constraints whose acceleration terms contradict the others.
     #[error("redundant constraints {constraints:?} are inconsistent at t = {t}: acceleration residual {residual:e}")]
@@ -335,14 +339,20 @@ impl Dynamics {
         let J = &ws.jacobian;
         let mut elim = Elimination::new(m, n);
         elim.load(J);
-        let rank = elim.phase(0, m, m, self.params.rank_tolerance).rank;
+        // The constraint block of the augmented matrix has pivots of the order of those
+        // of J M⁻¹ Jᵀ, the squares of J's: rows of J whose pivot ratio is below the
+        // square root of the tolerance are what made the augmented matrix fail it (near
+        // a change point, where loop closures become dependent).
+        let rank = elim.phase(0, m, m, self.params.rank_tolerance.sqrt()).rank;
         if rank == m {
             let mut lu = DenseLu::new(n + m, 1);
             fill_dense(&mut lu, info, ws, None);
+            let coordinates = free_coordinates(&mut lu, info, self.params.rank_tolerance);
             return Err(DynamicsError::Singular {
                 t,
                 rank,
                 ratio: lu.factor().ratio(),
+                coordinates,
             });
         }
         let rows_r: Vec<usize> = elim.rows[..rank].to_vec();
@@ -354,9 +364,15 @@ impl Dynamics {
         // Reduced augmented system with the independent rows.
         let mut lu = DenseLu::new(n + rank, 1);
         fill_dense(&mut lu, info, ws, Some(&rows_r));
+        let coordinates = free_coordinates(&mut lu, info, self.params.rank_tolerance);
         let ratio = lu.factor().ratio();
         if ratio.is_nan() || ratio <= self.params.rank_tolerance {
-            return Err(DynamicsError::Singular { t, rank, ratio });
+            return Err(DynamicsError::Singular {
+                t,
+                rank,
+                ratio,
+                coordinates,
+            });
         }
         let mut x = vec![0.0; n + rank];
         x[..n].copy_from_slice(&self.b[..n]);
@@ -432,6 +448,39 @@ impl Dynamics {
             rank,
             pivot_ratio: ratio,
         })
+    }
+}
+
+/// The coordinates whose accelerations the augmented matrix in `lu` (filled, not yet
+/// factored) leaves without a pivot under complete pivoting with the relative
+/// tolerance `tol`: those a singular system does not determine.
+fn free_coordinates(lu: &mut DenseLu, info: &Info, tol: f64) -> Vec<&'static str> {
+    let dim = lu.dim();
+    let a = lu.matrix_mut();
+    let mut dense = vec![0.0; dim * dim];
+    for i in 0..dim {
+        for j in 0..dim {
+            dense[i * dim + j] = a[(i, j)];
+        }
+    }
+    let mut elim = Elimination::new(dim, dim);
+    elim.load(&dense);
+    let rank = elim.phase(0, dim, dim, tol).rank;
+    let mut free: Vec<usize> = elim.cols[rank..]
+        .iter()
+        .copied()
+        .filter(|&j| j < info.nq())
+        .collect();
+    free.sort_unstable();
+    free.iter().map(|&j| info.coordinates[j].name).collect()
+}
+
+/// "coordinates involved: [..]", or why none are named.
+fn free_list(coordinates: &[&str]) -> String {
+    if coordinates.is_empty() {
+        "no single coordinate is undetermined (the singular direction mixes accelerations and multipliers)".to_owned()
+    } else {
+        format!("coordinates involved: {coordinates:?}")
     }
 }
 

@@ -3,8 +3,10 @@
 //! - **K1, position** ([`Kinematics::position`]): Newton–Raphson on the dependent
 //!   coordinates $\beta$ with $p = [\eta; \gamma]$ fixed,
 //!   $C_\beta\,\Delta\beta = -C(\beta, p, t)$, until
-//!   $\lVert\Delta\beta\rVert_\infty \le \varepsilon(1 + \lVert\beta\rVert_\infty)$ and
-//!   $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$.
+//!   $\lVert\Delta\beta\rVert_\infty \le \varepsilon\lVert q\rVert_\infty$ and every
+//!   constraint is within $\varepsilon\lVert q\rVert_\infty$ of its surface,
+//!   $|C_i| \le \varepsilon\,\lVert (C_q)_i\rVert_\infty \lVert q\rVert_\infty$ (the scale
+//!   model of [`crate::scale`]: the outcome does not depend on units).
 //! - **K2, velocity** ([`Kinematics::velocity`]): the dependent velocities from (E34),
 //!   $J_d [\dot\beta; \dot\eta] = -J_\gamma \dot\gamma - [C_t; g]$.
 //! - **Monitor** ([`Kinematics::monitor`]): recompute the pivot ratios of the current
@@ -23,6 +25,7 @@ use crate::partition::{
     compute_with, condition_with, Condition, Partition, PartitionError, PartitionParams,
     Preferences,
 };
+use crate::scale;
 use crate::workspace::{check_same_model, check_state, EvalError, Workspace};
 use crate::{Info, Mechanism};
 
@@ -68,7 +71,7 @@ pub struct NewtonStats {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum KinematicsError {
     /// Newton did not converge.
-    #[error("position analysis failed at t = {t} after {iterations} iterations: residual {residual:e}, violated constraints {violated:?}")]
+    #[error("position analysis failed at t = {t} after {iterations} iterations: residual {residual:e}, {}", if violated.is_empty() { "every constraint within the tolerance but the Newton step did not settle".to_owned() } else { format!("violated constraints {violated:?}") })]
     NewtonFailed {
         /// Time.
         t: f64,
@@ -324,8 +327,12 @@ impl Kinematics {
         ws.eval_constraints(mech, t, q)?;
         let mut residual = inf_norm(&ws.c);
         history.push(residual);
-        let c_tol = |q: &[f64]| tol * (1.0 + inf_norm(q));
-        if residual <= c_tol(q) {
+        // C_q at the iterate: the scale of the residual test, and the first Newton matrix.
+        ws.eval_jacobian(mech, t, q)?;
+        let met = |ws: &Workspace, q: &[f64]| {
+            scale::all_met(&ws.c, &ws.jacobian, n, tol, scale::coordinate_size(q))
+        };
+        if met(ws, q) {
             return Ok(NewtonStats {
                 iterations: 0,
                 residual,
@@ -334,7 +341,9 @@ impl Kinematics {
         }
         let mut step = f64::INFINITY;
         for iteration in 1..=params.newton.max_iterations {
-            ws.eval_jacobian(mech, t, q)?;
+            if iteration > 1 {
+                ws.eval_jacobian(mech, t, q)?;
+            }
             {
                 let mut a = lu_h.matrix_mut();
                 for (r, &i) in rows.iter().enumerate() {
@@ -357,18 +366,17 @@ impl Kinematics {
             }
             lu_h.solve_vec(dx);
             step = 0.0;
-            let mut beta_norm = 0.0_f64;
             for (k, &j) in beta.iter().enumerate() {
                 q[j] += dx[k];
                 step = step.max(dx[k].abs());
-                beta_norm = beta_norm.max(q[j].abs());
             }
             ws.eval_constraints(mech, t, q)?;
             residual = inf_norm(&ws.c);
             if history.len() < history.capacity() {
                 history.push(residual);
             }
-            if step <= tol * (1.0 + beta_norm) && residual <= c_tol(q) {
+            // The row norms of the last C_q (one update old) scale the residual test.
+            if step <= tol * scale::coordinate_size(q) && met(ws, q) {
                 return Ok(NewtonStats {
                     iterations: iteration,
                     residual,
@@ -379,13 +387,9 @@ impl Kinematics {
                 break;
             }
         }
-        let bound = c_tol(q);
-        let violated =
-            ws.c.iter()
-                .zip(info.holonomic)
-                .filter(|(c, _)| c.is_nan() || c.abs() > bound)
-                .map(|(_, s)| s.name)
-                .collect();
+        let violated = scale::unmet(&ws.c, &ws.jacobian, n, tol, scale::coordinate_size(q))
+            .map(|i| info.holonomic[i].name)
+            .collect();
         let _ = step;
         Err(KinematicsError::NewtonFailed {
             t,

@@ -41,10 +41,14 @@ mod mechanism;
 pub mod ode;
 mod partition;
 mod reactions;
+mod scale;
 pub mod sim;
 mod workspace;
 
-pub use assembly::{AssemblyError, AssemblyReport, Prescription};
+pub use assembly::{
+    AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
+    CONSISTENCY_TOLERANCE,
+};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
     DEFAULT_CROSSOVER,

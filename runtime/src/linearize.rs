@@ -62,7 +62,12 @@ impl Default for LinearizeParams {
                     tolerance: 1e-14,
                     max_iterations: 50,
                 },
-                partition: PartitionParams::default(),
+                // Redundant holonomic constraints are left out of K1 and K2, as in a
+                // simulation; the acceleration solve handles them.
+                partition: PartitionParams {
+                    allow_redundant: true,
+                    ..PartitionParams::default()
+                },
             },
             dynamics: DynamicsParams::default(),
         }

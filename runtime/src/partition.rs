@@ -13,8 +13,10 @@
 //! Then $J_d = \begin{bmatrix}C_\beta & C_\eta\\ G_\beta & G_\eta\end{bmatrix}$ is
 //! non-singular with $|\det J_d| = |\det C_\beta|\,|\det \hat G_\eta|$.
 //!
-//! A pivot below `pivot_tolerance` × (largest entry) means redundant or singular
-//! constraints: the rows left without a pivot are reported by name.
+//! Pivots are chosen on $J$ with its rows scaled to a largest entry near 1 (see
+//! [`crate::scale`]), so that the partition does not depend on the units of the
+//! constraints. A pivot below `pivot_tolerance` × (largest entry) means redundant or
+//! singular constraints: the rows left without a pivot are reported by name.
 //!
 //! **Condition monitor.** The partition stores, per block, the ratio
 //! $\rho = \min_k |u_{kk}| / \max_{ij} |a_{ij}|$ of the smallest pivot of $C_\beta$
@@ -293,7 +295,10 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
         elim.tier[i] = Tier::Allowed;
     }
     let ph1 = elim.phase(0, mh, mh, params.pivot_tolerance);
-    if ph1.rank < mh && params.allow_redundant && m == mh && ph1.first_allowed.is_none() {
+    // Redundant rows are allowed: a prescription that could not be kept out of β is
+    // the error to report (below), else the rows left without a pivot are dropped.
+    let redundant_allowed = params.allow_redundant && m == mh;
+    if ph1.rank < mh && redundant_allowed && ph1.first_allowed.is_none() {
         let r = ph1.rank;
         let mut rows = elim.rows[..r].to_vec();
         let mut redundant = elim.rows[r..mh].to_vec();
@@ -310,11 +315,11 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
                 holonomic: ph1.ratio(r),
                 nonholonomic: 1.0,
             },
-            abs_det: ph1.abs_det,
+            abs_det: unscaled_det(elim, ph1.abs_det, ph1.rank),
             time: t,
         });
     }
-    if ph1.rank < mh {
+    if ph1.rank < mh && !redundant_allowed {
         return Err(PartitionError::RedundantHolonomic {
             t,
             constraints: names(&elim.rows[ph1.rank..mh]),
@@ -381,9 +386,17 @@ pub(crate) fn compute_with<M: Mechanism + ?Sized>(
             holonomic: ph1.ratio(mh),
             nonholonomic: ph2.ratio(m - mh),
         },
-        abs_det: ph1.abs_det,
+        abs_det: unscaled_det(elim, ph1.abs_det, ph1.rank),
         time: t,
     })
+}
+
+/// $|\det C_\beta|$ of the original rows from the product of the first `rank` pivots of
+/// the row-scaled matrix.
+fn unscaled_det(elim: &Elimination, scaled: f64, rank: usize) -> f64 {
+    elim.rows[..rank]
+        .iter()
+        .fold(scaled, |d, &r| d / elim.row_scale[r])
 }
 
 /// The condition monitor on a reusable elimination scratch.
@@ -400,6 +413,10 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
     check_state(info, t, q, None)?;
     ws.eval_jacobian(mech, t, q)?;
     elim.load(&ws.jacobian);
+    // The dropped redundant rows do not enter K1 and K2: the kept ones must stay
+    // regular on β (at the bottom of the parallelogram's swing its three pin_y rows
+    // become dependent, and a partition that dropped a pin_x row must be renewed).
+    elim.clear_rows(&partition.redundant);
     elim.tier.fill(Tier::Forbidden);
     for &i in &partition.dependent {
         elim.tier[i] = Tier::Preferred;

@@ -7,7 +7,7 @@ use common::Pendulum;
 use pfaff::{
     AssemblyError, Dynamics, DynamicsParams, EvalError, Kinematics, KinematicsError,
     KinematicsParams, LinearSolver, Mechanism, PartitionError, Prescription, Quantity, SolverPath,
-    Workspace,
+    StateLevel, Workspace,
 };
 
 #[test]
@@ -109,24 +109,37 @@ fn assembly_errors_are_clear() {
         kin.assemble(&mech, &mut ws, 0.0, &mut q, &mut qd, &p)
             .unwrap_err()
     };
+    // Every coordinate given, off the circle: the residual x² + y² − l² = 0.25 − 1.
     let err = run(Prescription {
-        coordinates: &[("x", 0.6), ("y", -0.8)],
+        coordinates: &[("x", 0.3), ("y", -0.4)],
         velocities: &[],
     });
     println!("{err}");
-    assert!(matches!(
-        err,
-        AssemblyError::Partition(PartitionError::PrescribedCoordinate { .. })
-    ));
+    match &err {
+        AssemblyError::Inconsistent { level, violated } => {
+            assert_eq!(*level, StateLevel::Positions);
+            assert_eq!(violated.len(), 1);
+            assert_eq!(violated[0].constraint, "rod");
+            assert!((violated[0].residual + 0.75).abs() < 1e-15);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(err.to_string().contains("`rod` by -7.500e-1"), "{err}");
+    // Every velocity given, not tangent at the assembled position: C_q q̇ = 2x·1 + 2y·0
+    // with x ≥ 0.3 on the circle.
     let err = run(Prescription {
         coordinates: &[],
-        velocities: &[("x", 1.0), ("y", 1.0)],
+        velocities: &[("x", 1.0), ("y", 0.0)],
     });
     println!("{err}");
-    assert!(matches!(
-        err,
-        AssemblyError::Partition(PartitionError::PrescribedVelocity { .. })
-    ));
+    match &err {
+        AssemblyError::Inconsistent { level, violated } => {
+            assert_eq!(*level, StateLevel::Velocities);
+            assert_eq!(violated[0].constraint, "rod");
+            assert!(violated[0].residual >= 0.6, "{violated:?}");
+        }
+        other => panic!("{other:?}"),
+    }
     let err = run(Prescription {
         coordinates: &[("theta", 0.6)],
         velocities: &[],
@@ -148,6 +161,58 @@ fn assembly_errors_are_clear() {
     )
     .unwrap();
     assert!((q[1] + 0.8).abs() < 1e-14 && (qd[1] - 0.6).abs() < 1e-14);
+}
+
+/// A full state (every coordinate and velocity) on the constraints is kept as given,
+/// bit for bit, within the consistency tolerance: x = 0.6, y = −0.8 (x² + y² = 1 up to
+/// round-off) turning at 1.5 rad/s, and the same off by 1e-10 relative.
+#[test]
+fn a_full_consistent_state_is_accepted_as_given() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    for off in [0.0, 1e-10] {
+        let given = ([0.6 * (1.0 + off), -0.8], [0.8 * 1.5, 0.6 * 1.5]);
+        let (mut q, mut qd) = ([0.0, -1.0], [0.0; 2]);
+        let report = kin
+            .assemble(
+                &mech,
+                &mut ws,
+                0.0,
+                &mut q,
+                &mut qd,
+                &Prescription {
+                    coordinates: &[("x", given.0[0]), ("y", given.0[1])],
+                    velocities: &[("x", given.1[0]), ("y", given.1[1])],
+                },
+            )
+            .unwrap();
+        assert_eq!((q, qd), given);
+        assert_eq!(report.newton.iterations, 0);
+        assert!(report.newton.residual <= 2.0 * off + 1e-15);
+    }
+    // Off by 1e-6: the check fails, at the positions first.
+    let (mut q, mut qd) = ([0.0; 2], [0.0; 2]);
+    let err = kin
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription {
+                coordinates: &[("x", 0.6 * (1.0 + 1e-6)), ("y", -0.8)],
+                velocities: &[("x", 1.2), ("y", 0.9)],
+            },
+        )
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        AssemblyError::Inconsistent {
+            level: StateLevel::Positions,
+            ..
+        }
+    ));
 }
 
 #[test]

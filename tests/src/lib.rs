@@ -13,6 +13,8 @@ mod cli;
 #[cfg(test)]
 mod free_motion;
 #[cfg(test)]
+mod fuzz;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;

@@ -17,6 +17,8 @@
 // Index loops mirror the mathematics (M_ij, rows r and columns j of C_q).
 #![allow(clippy::needless_range_loop)]
 
+#[cfg(test)]
+mod bounds;
 pub mod ctxt;
 pub mod derive;
 pub mod emit;

@@ -117,11 +117,14 @@ pub struct StateArgs {
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub set: Vec<Assignment>,
     /// Set an initial coordinate, held during assembly (repeatable); the other
-    /// coordinates are solved from the constraints.
+    /// coordinates are solved from the constraints. Given for every coordinate, the
+    /// values are checked against the constraints instead (an error names the violated
+    /// ones).
     #[arg(long = "q0", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub q0: Vec<Assignment>,
     /// Set an initial velocity, held during assembly (repeatable); the dependent
-    /// velocities are solved from the constraints.
+    /// velocities are solved from the constraints. Given for every coordinate, the
+    /// values are checked against the constraints instead.
     #[arg(long = "qd0", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub qd0: Vec<Assignment>,
 }

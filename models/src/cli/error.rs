@@ -1,43 +1,82 @@
 //! Errors of the program and how they reach the user: one line on stderr and an exit
-//! code (2 for bad input, 1 for a failed computation or an I/O error).
+//! code (2 for bad input, 1 for a failed computation or an I/O error), and with
+//! `--json` one object on stdout (see [`CliError::json`]).
 
 use std::fmt;
 
+use serde_json::{json, Value};
+
 /// A failure of the program.
 #[derive(Debug)]
-pub enum CliError {
-    /// The input is wrong: unknown names, malformed values, impossible options.
-    Usage(String),
-    /// A computation or a file operation failed.
-    Failed(String),
+pub struct CliError {
+    code: u8,
+    kind: &'static str,
+    message: String,
+    /// The command already printed its JSON object (with this error in it).
+    reported: bool,
 }
 
 impl CliError {
     /// The process exit code.
     pub fn code(&self) -> u8 {
-        match self {
-            Self::Usage(_) => 2,
-            Self::Failed(_) => 1,
-        }
+        self.code
+    }
+
+    /// The same error with another `kind` for the JSON report.
+    #[must_use]
+    pub fn kind(mut self, kind: &'static str) -> Self {
+        self.kind = kind;
+        self
+    }
+
+    /// Marks the error as already reported in the JSON object on stdout.
+    #[must_use]
+    pub fn reported(mut self) -> Self {
+        self.reported = true;
+        self
+    }
+
+    /// Whether the JSON object on stdout already carries the error.
+    pub fn is_reported(&self) -> bool {
+        self.reported
+    }
+
+    /// The `error` entry of a JSON report: `kind` and `message`.
+    pub fn entry(&self) -> Value {
+        json!({"kind": self.kind, "message": self.message})
+    }
+
+    /// The whole JSON report of a command that failed before it had anything else to
+    /// say: `{"error": {"kind", "message"}}`.
+    pub fn json(&self) -> Value {
+        json!({"error": self.entry()})
     }
 }
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Usage(m) | Self::Failed(m) => f.write_str(m),
-        }
+        f.write_str(&self.message)
     }
 }
 
-/// A usage error.
+/// A usage error (exit code 2, kind `usage`).
 pub fn usage(message: impl Into<String>) -> CliError {
-    CliError::Usage(message.into())
+    CliError {
+        code: 2,
+        kind: "usage",
+        message: message.into(),
+        reported: false,
+    }
 }
 
-/// A failure.
+/// A failure (exit code 1, kind `failed`).
 pub fn failed(message: impl Into<String>) -> CliError {
-    CliError::Failed(message.into())
+    CliError {
+        code: 1,
+        kind: "failed",
+        message: message.into(),
+        reported: false,
+    }
 }
 
 /// `", did you mean `x`?"` when one of `candidates` is close to `name` (edit distance at

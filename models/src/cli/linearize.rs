@@ -42,7 +42,26 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
             entry.name
         )));
     }
-    // The steady motion's values are guesses; --q0/--qd0 are held (and win).
+    // The steady motion's values are guesses; --q0/--qd0 are held (and win), and then
+    // the operating point is the state they give, not the steady motion.
+    let given: Vec<String> = (args
+        .state
+        .q0
+        .iter()
+        .map(|a| format!("{} = {}", a.name, a.value)))
+    .chain(
+        args.state
+            .qd0
+            .iter()
+            .map(|a| format!("{}' = {}", a.name, a.value)),
+    )
+    .collect();
+    if !given.is_empty() {
+        about = format!(
+            "the state given by {} (the rest assembled)",
+            given.join(", ")
+        );
+    }
     let init = setup::assemble(model.as_ref(), &args.state, &guesses, &velocities)?;
     let lin = linearize(
         model.as_ref(),
@@ -52,14 +71,23 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
         ignorable,
         &LinearizeParams::default(),
     )
-    .map_err(|e| failed(format!("cannot linearize `{}`: {e}", entry.name)))?;
+    .map_err(|e| failed(format!("cannot linearize `{}`: {e}", entry.name)).kind("linearize"))?;
     let d = lin.states.len();
     let rows: Vec<Vec<f64>> = (0..d)
         .map(|i| (0..d).map(|j| lin.entry(i, j)).collect())
         .collect();
     if args.json {
+        let info = model.info();
+        let named = |v: &[f64]| -> serde_json::Map<String, serde_json::Value> {
+            info.coordinates
+                .iter()
+                .zip(v)
+                .map(|(c, x)| (c.name.to_owned(), json!(x)))
+                .collect()
+        };
         let value = json!({
             "model": entry.name,
+            "operating_point": {"about": about, "q": named(&lin.q), "qd": named(&lin.qd)},
             "states": lin.states.iter().map(ToString::to_string).collect::<Vec<_>>(),
             "eigenvalues": lin.eigenvalues.iter().map(|e| json!({"re": e.re, "im": e.im})).collect::<Vec<_>>(),
             "state_matrix": rows,

@@ -100,22 +100,33 @@ fn join_negative_values(args: impl Iterator<Item = String>) -> Vec<String> {
     out
 }
 
-/// Runs the program.
+/// Runs the program. With `--json` anywhere among the arguments, stdout holds exactly
+/// one JSON object whatever the exit code: the command's report, or
+/// `{"error": {"kind", "message"}}` when it failed before it had one.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse_from(join_negative_values(std::env::args())) {
+    let args = join_negative_values(std::env::args());
+    let json = args.iter().skip(1).any(|a| a == "--json");
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
         Err(e) => {
             if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
                 let _ = e.print();
                 return ExitCode::SUCCESS;
             }
-            eprintln!("pfaff: error: {} (see `pfaff --help`)", one_line(&e));
+            let message = format!("{} (see `pfaff --help`)", one_line(&e));
+            if json {
+                println!("{}", error::usage(message.clone()).json());
+            }
+            eprintln!("pfaff: error: {message}");
             return ExitCode::from(2);
         }
     };
     match dispatch(&cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            if json && !e.is_reported() {
+                println!("{}", e.json());
+            }
             eprintln!("pfaff: error: {e}");
             ExitCode::from(e.code())
         }

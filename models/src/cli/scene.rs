@@ -102,6 +102,17 @@ impl Scene {
                 steady: None,
                 closed_form: Some(seed2_example1_exact),
             },
+            "parallelogram" => Self {
+                // Falling from θ = π/3, the cranks reach the horizontal at t ≈ 0.497 s:
+                // there all three pin_x constraints coincide (a dead-centre, where the
+                // linkage can change branch and C_q loses rank). Partitioning and
+                // projection cross it; Baumgarte's state, off the constraints by its
+                // drift, can make the redundant rows disagree at such points.
+                t_end: 0.45,
+                span: "the swing down to just before the horizontal dead-centre at 0.497 s",
+                steady: None,
+                closed_form: None,
+            },
             "seed2_example2" => Self {
                 t_end: 1.0,
                 span: "the span of math-spec V4",

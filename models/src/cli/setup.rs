@@ -5,9 +5,13 @@
 //! set, and $(q, \dot q)$ satisfying the constraints with the given values held.
 //! A coordinate given with `--q0` that the constraints must determine (both `x` and `y`
 //! of a pendulum, say) is used as the starting guess of Newton's method instead of
-//! being held; a note says so when the value moved.
+//! being held; a note says so when the value moved. The non-zero initial velocities
+//! declared by the model (`qd0`) are held where the constraints allow it; one that the
+//! constraints determine from the others gets a note with the value used.
 
-use pfaff::{AssemblyError, Kinematics, KinematicsParams, Mechanism, PartitionError};
+use pfaff::{
+    AssemblyError, Kinematics, KinematicsParams, Mechanism, PartitionError, PartitionParams,
+};
 use pfaff::{Prescription, Workspace};
 use pfaff_models::Entry;
 
@@ -134,7 +138,16 @@ pub fn assemble(
         .map(|a| (a.name.as_str(), a.value))
         .collect();
     let mut ws = Workspace::new(info).map_err(|e| failed(e.to_string()))?;
-    let mut kin = Kinematics::new(info, KinematicsParams::default());
+    // Redundant constraints (the parallelogram's third crank) are dropped from the
+    // position and velocity equations, as the simulation does.
+    let params = KinematicsParams {
+        partition: PartitionParams {
+            allow_redundant: true,
+            ..PartitionParams::default()
+        },
+        ..KinematicsParams::default()
+    };
+    let mut kin = Kinematics::new(info, params);
     let mut notes = Vec::new();
     loop {
         let (mut qa, mut qda) = (q.clone(), qd.clone());
@@ -142,11 +155,13 @@ pub fn assemble(
             coordinates: &held,
             velocities: &velocities,
         };
-        match kin.assemble(model, &mut ws, 0.0, &mut qa, &mut qda, &prescription) {
-            Ok(_) => {
+        match kin.assemble_declared(model, &mut ws, 0.0, &mut qa, &mut qda, &prescription) {
+            Ok((_, overridden)) => {
+                notes.extend(overridden.iter().map(ToString::to_string));
+                let size = qa.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
                 for a in &state.q0 {
                     let i = info.coordinate_index(&a.name).expect("checked");
-                    if (qa[i] - a.value).abs() > 1e-9 * (1.0 + a.value.abs()) {
+                    if (qa[i] - a.value).abs() > 1e-9 * size.max(a.value.abs()) {
                         notes.push(format!(
                             "`{}` is determined by the constraints: {} was used as a guess, assembled to {}",
                             a.name, a.value, qa[i]
@@ -166,10 +181,12 @@ pub fn assemble(
                 // Keep the value as a guess, let Newton move it if it must.
                 held.retain(|h| h.0 != coordinate);
             }
+
             Err(e) => {
-                return Err(usage(format!(
-                    "cannot assemble a consistent initial state: {e}"
-                )));
+                return Err(
+                    usage(format!("cannot assemble a consistent initial state: {e}"))
+                        .kind("assembly"),
+                );
             }
         }
     }

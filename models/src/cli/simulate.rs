@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pfaff::sim::{Formulation, Method, Run, SimError, SimErrorKind, Simulation};
+use pfaff::sim::{min_step, Formulation, Method, Run, SimError, SimErrorKind, Simulation};
 use pfaff::{Mechanism, MechanismExt};
 use serde_json::{json, Map, Value};
 
@@ -21,6 +21,10 @@ pub struct Request<'a> {
     pub t_end: f64,
     pub formulation: Formulation,
     pub method: Method,
+    /// The step size of `--step`, raised to what the span resolves.
+    pub step: Option<f64>,
+    /// Notes on input that was changed (a step raised).
+    pub notes: Vec<String>,
 }
 
 fn formulation(f: FormulationArg) -> Formulation {
@@ -49,6 +53,12 @@ fn positive(flag: &str, v: f64, allow_zero: bool) -> Result<(), CliError> {
 /// Checks the numbers of `args` and picks the defaults.
 pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>, CliError> {
     positive("--rtol", args.rtol, false)?;
+    if args.rtol > 1.0 {
+        return Err(usage(format!(
+            "invalid --rtol {:e}: expected at most 1 (a larger relative tolerance asks for no correct digit)",
+            args.rtol
+        )));
+    }
     positive("--atol", args.atol, true)?;
     let t_end = args.t_end.unwrap_or(scene.t_end);
     if !t_end.is_finite() || t_end <= 0.0 {
@@ -56,9 +66,19 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
             "--t-end {t_end} is not after the start time 0: expected a positive finite end time"
         )));
     }
+    let mut notes = Vec::new();
     if let Some(h) = args.step {
         positive("--step", h, false)?;
     }
+    let step = args.step.map(|h| {
+        let min = min_step(0.0, t_end);
+        if h < min {
+            notes.push(format!(
+                "--step {h:e} is below the smallest step the time resolves over [0, {t_end}] s: {min:e} was used"
+            ));
+        }
+        h.max(min)
+    });
     if args.samples == 0 {
         return Err(usage("invalid --samples 0: expected at least 1"));
     }
@@ -67,7 +87,7 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
     }
     let method = match args.integrator {
         IntegratorArg::Rk4 => Method::Rk4 {
-            h: args.step.unwrap_or(t_end / 1000.0),
+            h: step.unwrap_or(t_end / 1000.0),
         },
         IntegratorArg::Dopri5 => Method::Dopri5,
         IntegratorArg::Dop853 => Method::Dop853,
@@ -78,6 +98,8 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
         t_end,
         formulation: formulation(args.formulation),
         method,
+        step,
+        notes,
     })
 }
 
@@ -112,7 +134,7 @@ pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outc
         run,
         error,
         wall,
-        notes: init.notes,
+        notes: req.notes.iter().cloned().chain(init.notes).collect(),
     })
 }
 
@@ -147,7 +169,7 @@ fn run_once(
                 shown.set_position((t / t_end * 1000.0) as u64);
             }
         });
-    if let (Some(h), false) = (req.args.step, matches!(req.method, Method::Rk4 { .. })) {
+    if let (Some(h), false) = (req.step, matches!(req.method, Method::Rk4 { .. })) {
         sim = sim.initial_step(h);
     }
     sim = if dense {
@@ -169,6 +191,7 @@ fn kind_name(kind: &SimErrorKind) -> &'static str {
         SimErrorKind::Assembly(_) => "assembly",
         SimErrorKind::NewtonFailed { .. } => "newton_failed",
         SimErrorKind::Singular { .. } => "singular",
+        SimErrorKind::SingularMass { .. } => "singular_mass",
         SimErrorKind::StepSizeTooSmall { .. } => "step_size_too_small",
         SimErrorKind::MaxSteps { .. } => "max_steps",
         SimErrorKind::NonFinite { .. } => "non_finite",
@@ -248,10 +271,13 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         "wall_seconds": out.wall.as_secs_f64(),
     });
     if let Some(kind) = &out.error {
+        // The rest of the object is the partial run; `stopped_at` is the time of its
+        // last state (`final`), `t` the time the failure is tied to.
         obj["error"] = json!({
             "kind": kind_name(kind),
             "message": kind.to_string(),
             "t": kind.t(),
+            "stopped_at": run.final_state().map(|f| f.0),
         });
     }
     obj
@@ -265,7 +291,9 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     let mut w = String::new();
     let entry = pfaff_models::find(info.name);
     let _ = writeln!(w, "{}: {}", info.name, entry.map_or("", |e| e.summary));
-    let dof = info.nq() - info.nh();
+    // Redundant constraints (found by the run) remove no degree of freedom.
+    let rank = info.nh() - run.redundant_constraints.len().min(info.nh());
+    let dof = info.nq() - rank.min(info.nq());
     let dof = dof - info.nnh().min(dof);
     let _ = writeln!(
         w,
@@ -333,22 +361,48 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
             );
         }
         (None, _) => {
+            let _ = writeln!(w, "energy       {}", no_energy(info, run));
+        }
+    }
+    match run.final_state() {
+        Some((t, q, qd)) => {
+            let list: Vec<String> = info
+                .coordinates
+                .iter()
+                .zip(q.iter().zip(qd))
+                .map(|(c, (v, vd))| format!("{} = {v:.6} ({}' = {vd:.6})", c.name, c.name))
+                .collect();
+            let label = if out.error.is_some() {
+                "stopped at  "
+            } else {
+                "final       "
+            };
+            let _ = writeln!(w, "{label} t = {t}: {}", list.join(", "));
+        }
+        None => {
             let _ = writeln!(
                 w,
-                "energy       not conserved (applied forces or explicit time): no drift to report"
+                "stopped at   the start: no consistent state was computed"
             );
         }
     }
-    if let Some((t, q, _)) = run.final_state() {
-        let list: Vec<String> = info
-            .coordinates
-            .iter()
-            .zip(q)
-            .map(|(c, v)| format!("{} = {v:.6}", c.name))
-            .collect();
-        let _ = writeln!(w, "final        t = {t}: {}", list.join(", "));
-    }
     w
+}
+
+/// Why the summary reports no energy.
+fn no_energy(model: &pfaff::Info, run: &Run) -> &'static str {
+    let t = model.time;
+    if model.conservative {
+        if run.trajectory.is_empty() {
+            "not computed: the run stopped before its first state"
+        } else {
+            "not computed"
+        }
+    } else if t.mass || t.forces || t.holonomic || t.nonholonomic {
+        "not conserved (the model depends explicitly on time): no drift to report"
+    } else {
+        "not conserved (applied forces, or kinetic energy terms linear in the velocities): no drift to report"
+    }
 }
 
 /// Writes the CSV of the trajectory: `t`, the coordinates, the velocities (`NAME'`),
@@ -395,29 +449,46 @@ pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
     report(model.as_ref(), &req, &scene, &out)
 }
 
-/// Prints the report of `out` and writes the requested files.
+/// Prints the report of `out` and writes the requested files. With `--json` the one
+/// object on stdout carries the first failure (of the run, else of a file).
 pub fn report(
     model: &dyn Mechanism,
     req: &Request<'_>,
     scene: &Scene,
     out: &Outcome,
 ) -> Result<(), CliError> {
+    let mut files = Ok(());
     if let Some(path) = &req.args.csv {
-        write_csv(model, &out.run, path)?;
+        files = write_csv(model, &out.run, path);
     }
-    if let Some(path) = &req.args.plot {
-        plot::trajectory(model, &out.run, path)?;
+    if let (Some(path), Ok(())) = (&req.args.plot, &files) {
+        files = plot::trajectory(model, &out.run, path);
     }
+    let files = files.map_err(|e| e.kind("io"));
+    let result = match (&out.error, files) {
+        (Some(kind), _) => Err(failed(format!(
+            "simulation of `{}` failed: {kind}",
+            model.info().name
+        ))
+        .kind(kind_name(kind))),
+        (None, files) => files,
+    };
     if req.args.json {
-        println!("{}", json_report(model, req, out));
+        let mut obj = json_report(model, req, out);
+        if let (Err(e), None) = (&result, &out.error) {
+            obj["error"] = e.entry();
+        }
+        println!("{obj}");
         for note in &out.notes {
             eprintln!("pfaff: note: {note}");
         }
-    } else {
-        print!("{}", summary(model, req, scene, out));
-        for note in &out.notes {
-            println!("note         {note}");
-        }
+        return result.map_err(CliError::reported);
+    }
+    print!("{}", summary(model, req, scene, out));
+    for note in &out.notes {
+        println!("note         {note}");
+    }
+    if result.is_ok() {
         if let Some(path) = &req.args.csv {
             println!("trajectory   {}", path.display());
         }
@@ -425,11 +496,5 @@ pub fn report(
             println!("plot         {}", path.display());
         }
     }
-    match &out.error {
-        Some(kind) => Err(failed(format!(
-            "simulation of `{}` failed: {kind}",
-            model.info().name
-        ))),
-        None => Ok(()),
-    }
+    result
 }

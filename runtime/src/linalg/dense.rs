@@ -3,6 +3,15 @@
 //! Input: a square matrix written into [`DenseLu::matrix_mut`]. Output: the factors in
 //! place, the permutations, and the pivot magnitudes (the diagonal of $U$, which with
 //! complete pivoting is non-increasing in exact arithmetic and reveals the rank).
+//!
+//! **Equilibration.** Before factoring, the rows and then the columns are scaled by
+//! powers of two to a largest magnitude in $[1/\sqrt2, \sqrt2)$ ($A \to D_r A D_c$; exact
+//! in floating point), and solves undo the scaling. Units enter the matrices of the
+//! runtime as row and column scalings (the unit of a constraint scales its row of
+//! $C_q$, the unit of a coordinate its column, a mass unit the block $M$), so the pivot
+//! ratio, which decides singularity, does not depend on them: a pendulum of 1 t is as
+//! regular as one of 1 kg.
+//!
 //! Invariant: no allocation after [`DenseLu::new`].
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -42,6 +51,9 @@ pub(crate) struct DenseLu {
     col_inv: Vec<usize>,
     mem: MemBuffer,
     rhs_cols: usize,
+    /// Row and column scale factors of the last factorization (powers of two).
+    row_scale: Vec<f64>,
+    col_scale: Vec<f64>,
 }
 
 impl std::fmt::Debug for DenseLu {
@@ -68,6 +80,8 @@ impl DenseLu {
             col_inv: vec![0; n],
             mem: MemBuffer::new(req),
             rhs_cols: rhs_cols.max(1),
+            row_scale: vec![1.0; n],
+            col_scale: vec![1.0; n],
         }
     }
 
@@ -80,11 +94,34 @@ impl DenseLu {
         self.a.as_mut()
     }
 
-    /// Factors the matrix in place and returns its pivot magnitudes.
+    /// Equilibrates and factors the matrix in place and returns the pivot magnitudes
+    /// of the equilibrated matrix.
     pub fn factor(&mut self) -> Pivots {
         let n = self.n;
         if n == 0 {
             return Pivots { max: 1.0, min: 1.0 };
+        }
+        for i in 0..n {
+            let mut big = 0.0_f64;
+            for j in 0..n {
+                big = big.max(self.a[(i, j)].abs());
+            }
+            let s = power_of_two_inverse(big);
+            self.row_scale[i] = s;
+            for j in 0..n {
+                self.a[(i, j)] *= s;
+            }
+        }
+        for j in 0..n {
+            let mut big = 0.0_f64;
+            for i in 0..n {
+                big = big.max(self.a[(i, j)].abs());
+            }
+            let s = power_of_two_inverse(big);
+            self.col_scale[j] = s;
+            for i in 0..n {
+                self.a[(i, j)] *= s;
+            }
         }
         let _ = factor::lu_in_place(
             self.a.as_mut(),
@@ -129,11 +166,17 @@ impl DenseLu {
 
     /// Solves $A X = B$ in place with the last factorization; `rhs` is `n × k`,
     /// `k ≤ rhs_cols`.
-    pub fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) {
+    pub fn solve_in_place(&mut self, mut rhs: MatMut<'_, f64>) {
         if self.n == 0 {
             return;
         }
         debug_assert!(rhs.ncols() <= self.rhs_cols);
+        // D_r A D_c (D_c⁻¹ x) = D_r b.
+        for k in 0..rhs.ncols() {
+            for i in 0..self.n {
+                rhs[(i, k)] *= self.row_scale[i];
+            }
+        }
         let row = PermRef::new_checked(&self.row_fwd, &self.row_inv, self.n);
         let col = PermRef::new_checked(&self.col_fwd, &self.col_inv, self.n);
         solve::solve_in_place(
@@ -141,10 +184,15 @@ impl DenseLu {
             self.a.as_ref(),
             row,
             col,
-            rhs,
+            rhs.as_mut(),
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
+        for k in 0..rhs.ncols() {
+            for i in 0..self.n {
+                rhs[(i, k)] *= self.col_scale[i];
+            }
+        }
     }
 
     /// Solves $A x = b$ for one vector in place.
@@ -152,6 +200,18 @@ impl DenseLu {
         let n = self.n;
         self.solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
     }
+}
+
+/// The power of two nearest to $1/x$ (in the log sense), 1 for zero or non-finite $x$
+/// (a zero row stays zero and keeps the factorization singular), clamped so that the
+/// factor stays a normal number.
+pub(crate) fn power_of_two_inverse(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return 1.0;
+    }
+    #[allow(clippy::cast_possible_truncation)]
+    let e = (-x.log2().round()).clamp(-1000.0, 1000.0) as i32;
+    2.0_f64.powi(e)
 }
 
 /// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)

@@ -13,7 +13,17 @@
 //! after a phase over the holonomic rows the non-holonomic rows hold the Schur
 //! complement $\hat G = G_p - G_\beta C_\beta^{-1} C_p$ (Algorithm P, step 2).
 //!
+//! **Equilibration.** [`Elimination::load`] scales each row by a power of two to a
+//! largest magnitude near 1 (see [`DenseLu`](super::dense::DenseLu)), so that pivot
+//! choices and rank decisions do not depend on the units of the constraints. Columns
+//! are not equilibrated by their own entries: which coordinate becomes dependent is decided by comparing the
+//! derivatives of a constraint with respect to the coordinates, which scaling each
+//! column by its own largest entry would equalize (the single row of a pendulum,
+//! $[2x, 2y]$, would no longer say that $x$ is the better pivot near $y = 0$).
+//!
 //! Invariant: no allocation after [`Elimination::new`].
+
+use super::dense::power_of_two_inverse;
 
 /// How a column may be chosen as a pivot column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -35,7 +45,8 @@ pub(crate) struct Phase {
     pub scale: f64,
     /// Smallest pivot magnitude of the phase (`+∞` when `rank == 0`).
     pub min_pivot: f64,
-    /// Product of the pivot magnitudes of the phase.
+    /// Product of the pivot magnitudes of the phase (of the row-scaled matrix; divide
+    /// by the pivot rows' [`Elimination::row_scale`] for the original one).
     pub abs_det: f64,
     /// Position of the first pivot taken from an [`Tier::Allowed`] column, if any.
     pub first_allowed: Option<usize>,
@@ -68,6 +79,8 @@ pub(crate) struct Elimination {
     pub cols: Vec<usize>,
     /// Tier of each *original* column.
     pub tier: Vec<Tier>,
+    /// The factor each *original* row was scaled by at [`Elimination::load`].
+    pub row_scale: Vec<f64>,
 }
 
 impl Elimination {
@@ -79,13 +92,21 @@ impl Elimination {
             rows: (0..m).collect(),
             cols: (0..n).collect(),
             tier: vec![Tier::Preferred; n],
+            row_scale: vec![1.0; m],
         }
     }
 
-    /// Copies the first `m` rows of the row-major `a` (row length `n`), resets the
-    /// permutations and marks every column preferred.
+    /// Copies the first `m` rows of the row-major `a` (row length `n`), scales each to a
+    /// largest magnitude near 1, resets the permutations and marks every column
+    /// preferred.
     pub fn load(&mut self, a: &[f64]) {
-        self.a.copy_from_slice(&a[..self.m * self.n]);
+        let (m, n) = (self.m, self.n);
+        self.a.copy_from_slice(&a[..m * n]);
+        for (row, scale) in self.a.chunks_exact_mut(n.max(1)).zip(&mut self.row_scale) {
+            let s = power_of_two_inverse(row.iter().fold(0.0_f64, |b, v| b.max(v.abs())));
+            row.iter_mut().for_each(|v| *v *= s);
+            *scale = s;
+        }
         for (k, r) in self.rows.iter_mut().enumerate() {
             *r = k;
         }
@@ -93,6 +114,15 @@ impl Elimination {
             *c = k;
         }
         self.tier.fill(Tier::Preferred);
+    }
+
+    /// Zeroes the rows `rows` (original indices, before any phase) so that no pivot is
+    /// taken from them.
+    pub fn clear_rows(&mut self, rows: &[usize]) {
+        let n = self.n;
+        for &i in rows {
+            self.a[i * n..(i + 1) * n].fill(0.0);
+        }
     }
 
     /// Eliminates up to `count` pivots at positions `k0..k0+count`, with candidate rows

@@ -1,7 +1,7 @@
 //! Tolerances, options and work statistics shared by the integrators.
 //!
 //! Input: user settings. Output: validated settings (`validate`) and counters.
-//! Invariants: a validated [`Tolerances`] has finite, non-negative `rtol` and `atol`
+//! Invariants: a validated [`Tolerances`] has finite, non-negative `rtol` (at most 1) and `atol`
 //! with $\text{atol}_i + \text{rtol} > 0$ for every component.
 
 use super::error::OdeError;
@@ -62,15 +62,17 @@ impl Tolerances {
     ///
     /// # Errors
     /// [`OdeError::DimensionMismatch`] for a per-component vector of the wrong length,
-    /// [`OdeError::InvalidTolerance`] for negative or non-finite values, or a component
-    /// with both tolerances zero.
+    /// [`OdeError::InvalidTolerance`] for negative or non-finite values, an `rtol` above
+    /// 1, or a component with both tolerances zero.
     pub fn validate(&self, dim: usize) -> Result<(), OdeError> {
         let bad = |atol: f64| OdeError::InvalidTolerance {
             rtol: self.rtol,
             atol,
         };
         let ok = |x: f64| x.is_finite() && x >= 0.0;
-        if !ok(self.rtol) {
+        // A relative tolerance above 1 asks for no correct digit: the error estimate
+        // could never be compared with the solution meaningfully.
+        if !ok(self.rtol) || self.rtol > 1.0 {
             return Err(bad(self.atol));
         }
         if let Some(a) = &self.atol_components {

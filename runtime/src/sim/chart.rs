@@ -139,7 +139,7 @@ impl Chart {
         let mut rate = self
             .rate_per_distance
             .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
-        let floor = 8.0 * f64::EPSILON * (1.0 + inf_norm(q));
+        let floor = 8.0 * f64::EPSILON * inf_norm(q);
         let mut previous: Option<f64> = None;
         for iteration in 0..=MAX_ITERATIONS {
             ws.eval_constraints(mech, t, q)?;

@@ -30,8 +30,9 @@ use crate::{
     Preferences, Prescription,
 };
 
-/// Pivot ratio below which constraints are reported as nearly dependent in a failure.
-const NEAR_SINGULAR: f64 = 1e-3;
+/// Pivot ratios below which constraints are reported as nearly dependent in a failure,
+/// tried in turn.
+const NEAR_SINGULAR: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
 /// Most rows an [`Output::Every`] grid may ask for: a finer grid is a mistake (a unit
 /// error) whose rows would not fit in memory; [`Output::Steps`] records every step.
@@ -80,6 +81,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     monitors: Monitors,
     started: Instant,
     y: &'a mut [f64],
+    overridden: Vec<crate::OverriddenVelocity>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -118,27 +120,45 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     }
 
     /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
-    /// below [`NEAR_SINGULAR`]) at the last full state: those that lock the mechanism
+    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state: those that lock the mechanism
     /// when an iteration stalls on a singular Jacobian with a small residual.
     fn nearly_dependent(&mut self) -> Vec<&'static str> {
         let sys = &mut self.sys;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
         };
-        let params = PartitionParams {
-            pivot_tolerance: NEAR_SINGULAR,
-            ..PartitionParams::default()
-        };
-        match Partition::compute(
-            sys.mech,
-            &mut sys.ws,
-            t,
-            &sys.q,
-            Preferences::default(),
-            &params,
-        ) {
-            Err(PartitionError::RedundantHolonomic { constraints, .. }) => constraints,
-            _ => Vec::new(),
+        // The weakest rows first: a stall near a fold (a slider at its reach) leaves a
+        // pivot ratio of a few 1e-3 at the last accepted state.
+        for tolerance in NEAR_SINGULAR {
+            let params = PartitionParams {
+                pivot_tolerance: tolerance,
+                ..PartitionParams::default()
+            };
+            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) = Partition::compute(
+                sys.mech,
+                &mut sys.ws,
+                t,
+                &sys.q,
+                Preferences::default(),
+                &params,
+            ) {
+                return constraints;
+            }
+        }
+        Vec::new()
+    }
+
+    /// Adds a row at the integrator's last accepted state when the rows end before it
+    /// (output on a grid, or only at the end), so that a partial run ends where the
+    /// integration stopped. Skipped when the state cannot be reconstructed.
+    fn record_last_accepted(&mut self, stepper: &Stepper) {
+        let t = stepper.t();
+        if self.traj.t.last().is_some_and(|&last| last >= t) || self.y.len() != stepper.y().len() {
+            return;
+        }
+        self.y.copy_from_slice(stepper.y());
+        if self.sys.reconstruct_exact(t, self.y).is_ok() {
+            let _ = self.record(t);
         }
     }
 
@@ -162,10 +182,14 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats,
             monitors: self.monitors,
             redundant_constraints: self.sys.redundant.clone(),
+            overridden_velocities: self.overridden.clone(),
         }
     }
 
     fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+        if let Some(s) = stepper {
+            self.record_last_accepted(s);
+        }
         if let SimErrorKind::NewtonFailed { constraints, .. }
         | SimErrorKind::Singular { constraints, .. } = &mut kind
         {
@@ -201,6 +225,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             },
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
+            overridden_velocities: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -247,8 +272,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         coordinates: &pq,
         velocities: &pqd,
     };
-    sys.kin
-        .assemble(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
+    let (_, overridden) = sys
+        .kin
+        .assemble_declared(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
         .map_err(|e| empty(assembly_error(e)))?;
     sys.q.copy_from_slice(&q);
     sys.qd.copy_from_slice(&qd);
@@ -269,6 +295,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         monitors: Monitors::default(),
         started,
         y: &mut y,
+        overridden,
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -286,7 +313,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
-        h_init: sim.h_init,
+        h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
         h_max,
         max_steps: sim.max_steps,
         dense_output: true,

@@ -110,7 +110,7 @@ pub enum SimErrorKind {
     #[error("cannot assemble the initial conditions: {0}")]
     Assembly(#[from] AssemblyError),
     /// A Newton iteration (K1 or the position projection) did not converge.
-    #[error("Newton iteration failed at t = {t} after {iterations} iterations: residual {residual:e}, constraints {constraints:?}")]
+    #[error("Newton iteration failed at t = {t} after {iterations} iterations: residual {residual:e}, {}", involved("constraints", constraints, "every residual is within the tolerance, the iteration stalled or kept landing on another solution branch"))]
     NewtonFailed {
         /// Time.
         t: f64,
@@ -124,7 +124,7 @@ pub enum SimErrorKind {
         constraints: Vec<&'static str>,
     },
     /// A matrix became singular.
-    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); constraints involved: {constraints:?}")]
+    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); {}", involved("constraints", constraints, "no residual exceeds the tolerance and no constraints are nearly dependent at the last recorded state"))]
     Singular {
         /// Time.
         t: f64,
@@ -135,6 +135,18 @@ pub enum SimErrorKind {
         /// Holonomic constraints whose residual exceeded the tolerance at that point,
         /// or else those Algorithm P finds nearly dependent at the last recorded state.
         constraints: Vec<&'static str>,
+    },
+    /// The augmented matrix of (E31) is singular while $J$ has full rank: the mass
+    /// matrix is singular on the tangent space of the constraints (a massless
+    /// coordinate that no constraint determines, for instance).
+    #[error("singular augmented matrix at t = {t} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", involved("coordinates", coordinates, "the singular direction mixes accelerations and multipliers"))]
+    SingularMass {
+        /// Time.
+        t: f64,
+        /// Smallest / largest pivot of the equilibrated matrix.
+        ratio: f64,
+        /// The coordinates whose accelerations are undetermined.
+        coordinates: Vec<&'static str>,
     },
     /// The step size fell below what the precision of `t` resolves.
     #[error("step size {h:e} too small at t = {t}")]
@@ -176,6 +188,7 @@ impl SimErrorKind {
         match self {
             Self::NewtonFailed { t, .. }
             | Self::Singular { t, .. }
+            | Self::SingularMass { t, .. }
             | Self::StepSizeTooSmall { t, .. }
             | Self::MaxSteps { t, .. }
             | Self::NonFinite { t, .. } => Some(*t),
@@ -224,11 +237,15 @@ impl SimErrorKind {
                 ratio,
                 constraints,
             },
-            Error::Dynamics(DynamicsError::Singular { t, rank, ratio }) => Self::Singular {
+            Error::Dynamics(DynamicsError::Singular {
                 t,
-                matrix: SingularMatrix::Augmented { rank },
                 ratio,
-                constraints,
+                coordinates,
+                ..
+            }) => Self::SingularMass {
+                t,
+                ratio,
+                coordinates,
             },
             Error::Eval(e)
             | Error::Kinematics(KinematicsError::Eval(e))
@@ -285,6 +302,15 @@ impl SimErrorKind {
             },
             other => Self::Integrator(other),
         }
+    }
+}
+
+/// `"{what} involved: [..]"`, or why none can be named.
+fn involved(what: &str, names: &[&str], otherwise: &str) -> String {
+    if names.is_empty() {
+        format!("no {what} identified: {otherwise}")
+    } else {
+        format!("{what} involved: {names:?}")
     }
 }
 

@@ -122,6 +122,17 @@ pub const NEWTON_TOLERANCE: f64 = 1e-14;
 /// $10^{-8}$).
 pub const REDUNDANT_TOLERANCE: f64 = 1e-4;
 
+/// The smallest step size a run over `[t0, t_end]` can start with anywhere in its span:
+/// $32\,\varepsilon \max(|t_0|, |t_\text{end}|)$, above the integrators' underflow limits
+/// ($10\,\varepsilon|t|$ for the Runge–Kutta methods, $4\varepsilon|t|$ for Adams). A
+/// smaller first step given to [`Simulation::initial_step`] is raised to it (the
+/// restarts after a re-partition start with it too, and would stop the run at the first
+/// one after the time has grown).
+#[must_use]
+pub fn min_step(t0: f64, t_end: f64) -> f64 {
+    32.0 * f64::EPSILON * t0.abs().max(t_end.abs())
+}
+
 /// How the constrained equations become an ODE (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Formulation {
@@ -296,7 +307,8 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
         self
     }
 
-    /// The first step size (and after every restart the method chooses again).
+    /// The first step size (also the first step after every restart). A step below
+    /// [`min_step`] of the span, which the time could not resolve, is raised to it.
     #[must_use]
     pub fn initial_step(mut self, h: f64) -> Self {
         self.h_init = Some(h);

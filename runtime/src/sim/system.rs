@@ -23,11 +23,23 @@ use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::dense::{gram_factor, DenseLu};
 use crate::linalg::inf_norm;
 use crate::ode::{OdeSystem, RhsError};
+use crate::scale;
 use crate::workspace::{EvalError, Workspace};
 use crate::{Error, Info, Mechanism};
 
 /// Pivot ratio below which a projection matrix counts as singular.
 const SINGULAR_RATIO: f64 = super::chart::SINGULAR_RATIO;
+
+/// Pivot ratio of the projection matrix (equilibrated $J_R J_R^\mathsf{T}$) below which
+/// the kept rows of a model with redundant constraints are renewed (see
+/// [`MechSystem::refit`]): a ratio of $10^{-8}$ is a condition of $10^4$ for $J_R$,
+/// where Newton starts to stall long before the matrix is singular.
+const REFIT_RATIO: f64 = 1e-8;
+
+/// Fraction of its value when the rows were chosen below which the pivot ratio of the
+/// chart's $N N^\mathsf{T}$ renews the kept rows of a model with redundant constraints:
+/// the kept rows are turning dependent while the dropped ones could take over.
+const REFIT_FRACTION: f64 = 1e-2;
 
 /// Recoverable failures in a row (since the last accepted step) before a failure stops
 /// the integrator: with the integrators' cut of 4 per failure the step has then shrunk
@@ -77,6 +89,9 @@ pub(crate) struct MechSystem<'a, M: Mechanism + ?Sized> {
     /// accepted state the integrator has just evaluated costs nothing.
     cached: Option<f64>,
     y_cached: Vec<f64>,
+    /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
+    /// before the first anchor): the reference of [`REFIT_FRACTION`].
+    fit_ratio: f64,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for MechSystem<'_, M> {
@@ -126,6 +141,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             retries: 0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
+            fit_ratio: 0.0,
         })
     }
 
@@ -174,9 +190,23 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
             .eval_jacobian(self.mech, t, &self.q)
             .map_err(SimErrorKind::from_eval)?;
         self.factorizations += 1;
-        let ratio = self
+        let mut ratio = self
             .chart
             .anchor(&self.ws, &self.q, &self.rows[..self.rows_h]);
+        let worse =
+            ratio.is_nan() || ratio <= REFIT_RATIO || ratio < REFIT_FRACTION * self.fit_ratio;
+        if worse && self.refit(t) {
+            self.ws
+                .eval_jacobian(self.mech, t, &self.q)
+                .map_err(SimErrorKind::from_eval)?;
+            ratio = self
+                .chart
+                .anchor(&self.ws, &self.q, &self.rows[..self.rows_h]);
+            self.fit_ratio = ratio;
+        }
+        if self.fit_ratio == 0.0 {
+            self.fit_ratio = ratio;
+        }
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
                 t,
@@ -224,12 +254,12 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     residual,
                 }) => {
                     self.newton_iterations += iterations as u64;
-                    let bound = self.kin.params().newton.tolerance * (1.0 + inf_norm(&self.q));
+                    let tol = self.kin.params().newton.tolerance;
                     return Err(SimErrorKind::NewtonFailed {
                         t,
                         iterations,
                         residual,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(tol),
                     });
                 }
             }
@@ -241,7 +271,7 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                 correction = correction.max((qj - yj).abs());
             }
             let scale = inf_norm(&self.q);
-            let floor = BRANCH_FLOOR * (1.0 + scale) + self.chart.tolerance(scale);
+            let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
             if correction > moved + floor {
                 return Err(SimErrorKind::NewtonFailed {
                     t,
@@ -350,6 +380,8 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         let (n, mh) = (info.nq(), info.nh());
         let newton = self.kin.params().newton;
         let eval = |e: EvalError| SimErrorKind::from_eval(e);
+        // One renewal of the dropped redundant rows per projection (see `refit`).
+        let mut refitted = false;
         if mh > 0 {
             let mut iterations = 0;
             loop {
@@ -357,27 +389,42 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
                     .eval_constraints(self.mech, t, &self.q)
                     .map_err(eval)?;
                 let residual = inf_norm(self.ws.constraints());
-                let bound = newton.tolerance * (1.0 + inf_norm(&self.q));
-                if residual <= bound {
+                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+                let tol = newton.tolerance;
+                let size = scale::coordinate_size(&self.q);
+                if scale::all_met(self.ws.constraints(), self.ws.jacobian(), n, tol, size) {
                     break;
                 }
-                if iterations == newton.max_iterations || !residual.is_finite() {
+                let stalled = iterations == newton.max_iterations || !residual.is_finite();
+                if stalled && !refitted && self.refit(t) {
+                    (refitted, iterations) = (true, 0);
+                    continue;
+                }
+                if stalled {
                     return Err(SimErrorKind::NewtonFailed {
                         t,
                         iterations,
                         residual,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(tol),
                     });
                 }
-                self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+                let ratio = gram_factor(
+                    &mut self.lu_h,
+                    &self.ws.jacobian,
+                    &self.rows[..self.rows_h],
+                    n,
+                );
+                if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
+                    refitted = true;
+                    continue;
+                }
                 let rows = &self.rows[..self.rows_h];
-                let ratio = gram_factor(&mut self.lu_h, &self.ws.jacobian, rows, n);
                 if ratio.is_nan() || ratio <= SINGULAR_RATIO {
                     return Err(SimErrorKind::Singular {
                         t,
                         matrix: SingularMatrix::Projection,
                         ratio,
-                        constraints: self.violated(bound),
+                        constraints: self.violated(tol),
                     });
                 }
                 for (mu, &i) in self.mu.iter_mut().zip(rows) {
@@ -410,8 +457,12 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         let eval = SimErrorKind::from_eval;
         self.velocity_terms(t).map_err(eval)?;
         self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+        let mut ratio = gram_factor(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
+        if (ratio.is_nan() || ratio <= REFIT_RATIO) && self.refit(t) {
+            self.ws.eval_jacobian(self.mech, t, &self.q).map_err(eval)?;
+            ratio = gram_factor(&mut self.lu_v, &self.ws.jacobian, &self.rows, n);
+        }
         let rows = &self.rows[..];
-        let ratio = gram_factor(&mut self.lu_v, &self.ws.jacobian, rows, n);
         self.factorizations += 1;
         if ratio.is_nan() || ratio <= SINGULAR_RATIO {
             return Err(SimErrorKind::Singular {
@@ -434,14 +485,44 @@ impl<'a, M: Mechanism + ?Sized> MechSystem<'a, M> {
         Ok(())
     }
 
-    fn violated(&self, bound: f64) -> Vec<&'static str> {
-        self.ws
-            .constraints()
-            .iter()
-            .zip(self.info.holonomic)
-            .filter(|(c, _)| c.is_nan() || c.abs() > bound)
-            .map(|(_, s)| s.name)
-            .collect()
+    /// Renews the redundant holonomic rows left out of the projections and the chart,
+    /// when there are any: which rows of a dependent set are independent changes along
+    /// the motion (the three pin_y rows of the parallelogram become dependent at the
+    /// bottom of its swing, and a set that dropped a pin_x row turns singular there).
+    /// Returns whether the rows were renewed (the rank of $C_q$ unchanged).
+    fn refit(&mut self, t: f64) -> bool {
+        let redundant = self
+            .kin
+            .partition()
+            .is_some_and(|p| !p.redundant_rows().is_empty());
+        if !redundant {
+            return false;
+        }
+        let rank = self.rows_h;
+        let ok = self
+            .kin
+            .repartition(self.mech, &mut self.ws, t, &self.q)
+            .is_ok_and(|p| p.holonomic_rows().len() == rank);
+        if ok {
+            self.fit_rows();
+        }
+        ok
+    }
+
+    /// The holonomic constraints not met to the relative `tolerance` at the last
+    /// evaluation of $C$ and $C_q$ (see [`crate::scale`]).
+    fn violated(&self, tolerance: f64) -> Vec<&'static str> {
+        let size = scale::coordinate_size(&self.q);
+        let n = self.info.nq();
+        scale::unmet(
+            self.ws.constraints(),
+            self.ws.jacobian(),
+            n,
+            tolerance,
+            size,
+        )
+        .map(|i| self.info.holonomic[i].name)
+        .collect()
     }
 }
 

@@ -204,6 +204,9 @@ pub struct Run {
     /// their small inconsistencies from drift are solved in the least-squares sense
     /// (see [`Dynamics`](crate::Dynamics)), and K1, K2 and the projection use the other rows.
     pub redundant_constraints: Vec<&'static str>,
+    /// Declared initial velocities that assembly had to change (see
+    /// [`Kinematics::assemble_declared`](crate::Kinematics::assemble_declared)).
+    pub overridden_velocities: Vec<crate::OverriddenVelocity>,
 }
 
 impl Run {

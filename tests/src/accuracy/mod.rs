@@ -12,7 +12,7 @@
 
 mod check;
 mod reference;
-mod util;
+pub(crate) mod util;
 
 mod andrews;
 mod car_axis;

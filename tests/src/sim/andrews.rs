@@ -3,7 +3,8 @@
 //! K1 guesses, extrapolated over long trial steps, can land on another assembly
 //! branch.
 
-use pfaff::sim::{Formulation, Method, Run, Simulation};
+use pfaff::sim::{Formulation, Method, Run, SimErrorKind, Simulation};
+use pfaff::AssemblyError;
 use pfaff_models::andrews;
 
 const T_END: f64 = 0.03;
@@ -56,5 +57,51 @@ fn partitioning_dop853_follows_the_reference_at_every_tolerance() {
         // (q error 1.3e2) and rtol 1e-4 at 8e-3.
         assert!(eq.max(ev) < 1e3 * rtol, "rtol {rtol:e}: q {eq:e} qd {ev:e}");
         assert!(part.stats.rejected > 0);
+    }
+}
+
+/// The consistent initial state of benchmark-models.md (`andrews`: seven angles to 30
+/// digits, all velocities zero) given in full is taken as it is: the first row is the
+/// given state, bit for bit.
+#[test]
+fn the_full_benchmark_state_is_accepted_as_given() {
+    let model = andrews::Model::default();
+    let names = ["beta", "theta", "gamma", "phi", "delta", "omega", "epsilon"];
+    #[allow(clippy::excessive_precision)] // the digits of benchmark-models.md
+    let values = [
+        -0.061_713_890_014_276_449_635_894_845_800_1,
+        0.0,
+        0.455_279_819_163_070_380_255_912_382_449,
+        0.222_668_390_165_885_884_674_473_185_609,
+        0.487_364_979_543_842_550_225_598_953_530,
+        -0.222_668_390_165_885_884_674_473_185_609,
+        1.230_547_444_549_821_192_497_350_155_68,
+    ];
+    let mut sim = Simulation::new(&model)
+        .formulation(Formulation::Partitioning)
+        .integrator(Method::Adams)
+        .output_times(&[]);
+    for (name, v) in names.iter().zip(values) {
+        sim = sim
+            .prescribe_coordinate(name, v)
+            .prescribe_velocity(name, 0.0);
+    }
+    let run = sim.run(1e-3).unwrap();
+    assert_eq!(run.trajectory.q(0), values);
+    assert!(run.trajectory.qd(0).iter().all(|&v| v == 0.0));
+    // Off by 1e-6 rad in gamma: the two loop closures through it are named.
+    let mut sim = Simulation::new(&model).output_times(&[]);
+    for (name, v) in names.iter().zip(values) {
+        let v = if *name == "gamma" { v + 1e-6 } else { v };
+        sim = sim.prescribe_coordinate(name, v);
+    }
+    let err = sim.run(1e-3).unwrap_err();
+    eprintln!("{err}");
+    match &err.kind {
+        SimErrorKind::Assembly(AssemblyError::Inconsistent { violated, .. }) => {
+            let names: Vec<&str> = violated.iter().map(|v| v.constraint).collect();
+            assert_eq!(names.len(), 2, "{names:?}");
+        }
+        other => panic!("{other:?}"),
     }
 }

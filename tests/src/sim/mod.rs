@@ -6,12 +6,15 @@
 //! test.
 
 mod andrews;
+mod declared;
 mod exact;
 mod faults;
 mod models;
 mod partitioning;
 mod pendulum;
+mod proportionality;
 mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
+mod units;

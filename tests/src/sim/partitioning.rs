@@ -106,3 +106,34 @@ fn andrews_takes_at_most_two_newton_updates_per_evaluation() {
         assert!(s.newton_iterations > 0);
     }
 }
+
+/// The pendulum to t = 1000 s (422 periods) at rtol = atol = 1e-12 with partitioning,
+/// with Adams (the command's default) and DOP853 (the library's default): the final
+/// position within 1e-7 of the closed form (benchmark-models.md; the exact solution at
+/// t = 1000 is x = −0.683230188552, y = −0.730203060423 by mpmath's `ellipfun`, which
+/// `exact::pendulum` reproduces to 1e-12).
+#[test]
+fn pendulum_to_t_1000_stays_within_1e_7_of_the_closed_form() {
+    let model = pendulum::Model::default();
+    let e = exact::pendulum(1000.0);
+    assert!((e[0] + 0.683_230_188_552).abs() < 1e-12, "{e:?}");
+    assert!((e[1] + 0.730_203_060_423).abs() < 1e-12, "{e:?}");
+    for method in [Method::Adams, Method::Dop853] {
+        let run = Simulation::new(&model)
+            .integrator(method)
+            .tolerances(1e-12, 1e-12)
+            .output_times(&[])
+            .run(1000.0)
+            .unwrap();
+        let (t, q, _) = run.final_state().unwrap();
+        assert_eq!(t, 1000.0);
+        let err = (q[0] - e[0]).abs().max((q[1] - e[1]).abs());
+        eprintln!(
+            "{}: error {err:.2e}, {} steps, {:?}",
+            method.name(),
+            run.stats.steps,
+            run.stats.wall_time
+        );
+        assert!(err < 1e-7, "{}: {err:e}", method.name());
+    }
+}

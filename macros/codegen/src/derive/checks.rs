@@ -1,5 +1,6 @@
 //! The checks of the derivation stage and their diagnostics.
 
+use proc_macro2::Span;
 use quote::ToTokens;
 
 use crate::ctxt::Ctxt;
@@ -8,7 +9,7 @@ use crate::model::Model;
 use crate::parse::FnItem;
 
 use super::Row;
-use crate::sym::{diff, transform, Deps, ExprId, Graph, Var};
+use crate::sym::{diff, transform, Deps, ExprId, Graph, Node, Var};
 
 use super::idx;
 
@@ -132,15 +133,32 @@ fn velocity_name(model: &Model, k: usize) -> String {
     format!("{}.dot()", model.coords[k].name)
 }
 
+/// The velocity that makes `e` fail a check: the first whose derivative of `e` is not
+/// zero, else the first that occurs in `e` at all (through `signum`, whose derivative
+/// is taken as zero), else "the velocities". Never an empty name.
+fn culprit_velocity(model: &Model, g: &mut Graph, e: ExprId) -> String {
+    let by_derivative = (0..model.nq()).find(|&k| {
+        let d = diff::differentiate(g, e, Var::Qd(idx(k)));
+        !g.is_zero(d)
+    });
+    let by_occurrence = || {
+        transform::post_order(g, &[e])
+            .into_iter()
+            .filter_map(|id| match g.node(id) {
+                Node::Var(Var::Qd(k)) => Some(*k as usize),
+                _ => None,
+            })
+            .min()
+    };
+    match by_derivative.or_else(by_occurrence) {
+        Some(k) => format!("`{}`", velocity_name(model, k)),
+        None => "the velocities".to_owned(),
+    }
+}
+
 /// Reports a kinetic energy whose Hessian entry `(i, j)` still depends on velocities.
 pub fn not_quadratic(cx: &Ctxt, model: &Model, g: &mut Graph, m: ExprId, i: usize, j: usize) {
-    let culprit = (0..model.nq())
-        .find(|&k| {
-            let d = diff::differentiate(g, m, Var::Qd(idx(k)));
-            !g.is_zero(d)
-        })
-        .map(|k| velocity_name(model, k))
-        .unwrap_or_default();
+    let culprit = culprit_velocity(model, g, m);
     let span = model
         .kinetic
         .as_ref()
@@ -149,7 +167,7 @@ pub fn not_quadratic(cx: &Ctxt, model: &Model, g: &mut Graph, m: ExprId, i: usiz
         span,
         format!(
             "the kinetic energy is not quadratic in the velocities: its second derivative with respect to \
-             `{}` and `{}` still depends on `{culprit}` (T must be T2 + T1 + T0)",
+             `{}` and `{}` still depends on {culprit} (T must be T2 + T1 + T0)",
             velocity_name(model, i),
             velocity_name(model, j),
         ),
@@ -232,17 +250,11 @@ pub fn holonomic(cx: &Ctxt, row: &Row, g: &Graph) -> bool {
 }
 
 pub fn not_linear(cx: &Ctxt, model: &Model, g: &mut Graph, row: &Row, d: ExprId) {
-    let culprit = (0..model.nq())
-        .find(|&k| {
-            let dd = diff::differentiate(g, d, Var::Qd(idx(k)));
-            !g.is_zero(dd)
-        })
-        .map(|k| velocity_name(model, k))
-        .unwrap_or_default();
+    let culprit = culprit_velocity(model, g, d);
     cx.error_at(
         row.span,
         format!(
-            "non-holonomic constraint `{}` is not linear in the velocities: `{culprit}` enters non-linearly",
+            "non-holonomic constraint `{}` is not linear in the velocities: {culprit} enters non-linearly",
             row.name
         ),
     );
@@ -270,4 +282,28 @@ pub fn nonholonomic(cx: &Ctxt, row: &Row, g: &Graph, no_velocity: bool) -> bool 
         return false;
     }
     true
+}
+
+/// Reports the first derived expression among `roots` that holds a constant which
+/// overflowed or underflowed to a non-finite value (`1e308 * x.dot().powi(2)` in `T`
+/// gives `M = 2e308 = inf`; a mass of `1e-320` gives an infinite inverse in the
+/// free-motion residual), as an error at `span` naming `what` it is. Literal constants
+/// are checked where they are written; these come from folding derived ones. Returns
+/// whether every constant is finite.
+pub fn finite(cx: &Ctxt, g: &Graph, roots: &[ExprId], what: &str, span: Span) -> bool {
+    let bad = transform::post_order(g, roots)
+        .into_iter()
+        .find_map(|id| g.as_const(id).filter(|v| !v.is_finite()));
+    match bad {
+        None => true,
+        Some(v) => {
+            cx.error_at(
+                span,
+                format!(
+                    "{what} holds a constant that evaluates to {v}: a derived constant overflows or underflows `f64`"
+                ),
+            );
+            false
+        }
+    }
 }

@@ -286,6 +286,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let mut ct = Vec::new();
     let mut gamma_h = Vec::new();
     let mut holonomic_names = Vec::new();
+    let mut holonomic_spans = Vec::new();
     for h in holonomic {
         let row = h?;
         let h = row.expr;
@@ -314,6 +315,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         c.push(h);
         ct.push(h_t);
         gamma_h.push(g.neg(s));
+        holonomic_spans.push(row.span);
         holonomic_names.push((row.name, row.docs));
     }
 
@@ -322,6 +324,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let mut gb = Vec::new();
     let mut gamma_nh = Vec::new();
     let mut nonholonomic_names = Vec::new();
+    let mut nonholonomic_spans = Vec::new();
     for item in nonholonomic {
         let item = item?;
         let nh = item.expr;
@@ -344,6 +347,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         if checking && !checks::nonholonomic(cx, &item, g, row.is_empty()) {
             continue;
         }
+        nonholonomic_spans.push(item.span);
         nonholonomic_names.push((item.name, item.docs));
         gm.extend(row);
         let bias = transform::substitute(g, nh, &mut |g, v| match v {
@@ -410,6 +414,55 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             rows,
         },
     );
+
+    if checking {
+        let kinetic_span = model
+            .kinetic
+            .as_ref()
+            .or(model.mass_matrix.as_ref())
+            .map_or_else(|| model.ident.span(), |k| k.name.span());
+        let potential_span = model
+            .potential
+            .as_ref()
+            .map_or(kinetic_span, |p| p.name.span());
+        let ok = checks::finite(
+            cx,
+            g,
+            &mass.iter().map(|e| e.expr).collect::<Vec<_>>(),
+            "the mass matrix",
+            kinetic_span,
+        ) && checks::finite(cx, g, &forces, "the generalized forces", potential_span);
+        for (r, span) in holonomic_spans.iter().enumerate() {
+            let mut roots = vec![c[r], ct[r], gamma_h[r]];
+            roots.extend(cq.iter().filter(|e| e.row == idx(r)).map(|e| e.expr));
+            let what = format!(
+                "holonomic constraint `{}` or its derivatives",
+                holonomic_names[r].0
+            );
+            checks::finite(cx, g, &roots, &what, *span);
+        }
+        for (r, span) in nonholonomic_spans.iter().enumerate() {
+            let mut roots = vec![gb[r], gamma_nh[r]];
+            roots.extend(gm.iter().filter(|e| e.row == idx(r)).map(|e| e.expr));
+            let what = format!(
+                "non-holonomic constraint `{}` or its derivatives",
+                nonholonomic_names[r].0
+            );
+            checks::finite(cx, g, &roots, &what, *span);
+        }
+        if let (true, Some(fm)) = (ok, &free_motion) {
+            checks::finite(
+                cx,
+                g,
+                &fm.symbolic,
+                "the free-motion residual (with the inverse of the mass matrix)",
+                kinetic_span,
+            );
+        }
+        if cx.has_errors() {
+            return None;
+        }
+    }
 
     let mut outs = Vec::new();
     for (name, docs, e) in outputs {

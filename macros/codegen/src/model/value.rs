@@ -502,9 +502,73 @@ impl Translator<'_> {
     }
 
     fn binary(&mut self, b: &syn::ExprBinary) -> Option<Value> {
+        if let Some(sum) = self.sum_chain(b) {
+            return sum;
+        }
         let lhs = self.value(&b.left);
         let rhs = self.value(&b.right);
         let (lhs, rhs) = (lhs?, rhs?);
+        self.combine(b, lhs, rhs)
+    }
+
+    /// A chain `a ± b ± c …` of three or more operands (parsed left-nested) whose
+    /// operands are all scalars, as one canonical sum. Added pairwise, every operand
+    /// rebuilds the partial sum, which is quadratic in the number of terms (a sum of
+    /// 6,000 terms took 5 s). `None` when `b` is not such a chain; a chain with vector
+    /// operands is combined pairwise as usual (its operands translated once).
+    fn sum_chain(&mut self, b: &syn::ExprBinary) -> Option<Option<Value>> {
+        let is_sum = |op: &syn::BinOp| matches!(op, syn::BinOp::Add(_) | syn::BinOp::Sub(_));
+        if !is_sum(&b.op) {
+            return None;
+        }
+        // The chain's nodes, innermost first.
+        let mut nodes = vec![b];
+        while let syn::Expr::Binary(inner) = &*nodes[nodes.len() - 1].left {
+            if !is_sum(&inner.op) {
+                break;
+            }
+            nodes.push(inner);
+        }
+        if nodes.len() < 2 {
+            return None;
+        }
+        nodes.reverse();
+        let first = self.value(&nodes[0].left);
+        let rest: Vec<Option<Value>> = nodes.iter().map(|n| self.value(&n.right)).collect();
+        let (Some(first), Some(rest)) = (first, rest.into_iter().collect::<Option<Vec<_>>>())
+        else {
+            return Some(None);
+        };
+        let scalars: Option<Vec<ExprId>> = std::iter::once(&first)
+            .chain(&rest)
+            .map(|v| match v {
+                Value::Scalar(x) => Some(*x),
+                _ => None,
+            })
+            .collect();
+        if let Some(scalars) = scalars {
+            let mut terms = Vec::with_capacity(scalars.len());
+            terms.push(scalars[0]);
+            for (n, &x) in nodes.iter().zip(&scalars[1..]) {
+                terms.push(match n.op {
+                    syn::BinOp::Sub(_) => self.g.neg(x),
+                    _ => x,
+                });
+            }
+            return Some(Some(Value::Scalar(self.g.add(terms))));
+        }
+        let mut acc = first;
+        for (n, v) in nodes.into_iter().zip(rest) {
+            match self.combine(n, acc, v) {
+                Some(next) => acc = next,
+                None => return Some(None),
+            }
+        }
+        Some(Some(acc))
+    }
+
+    /// `lhs op rhs` for translated operands of any kind.
+    fn combine(&mut self, b: &syn::ExprBinary, lhs: Value, rhs: Value) -> Option<Value> {
         if let (Value::Scalar(x), Value::Scalar(y)) = (&lhs, &rhs) {
             return self.scalar_binary(b, *x, *y).map(Value::Scalar);
         }

@@ -1,0 +1,80 @@
+//! The scales of the runtime's convergence and consistency decisions.
+//!
+//! A decision that compares a number with an absolute threshold changes its outcome
+//! with the units of the model. The runtime's decisions are made against these scales
+//! instead (ARCHITECTURE.md, "Decision: the scale model"):
+//!
+//! - **the size of $q$**: $s_q = \lVert q\rVert_\infty$, the precision to which the
+//!   coordinates can be known;
+//! - **a constraint's sensitivity**: $\lVert (C_q)_i\rVert_\infty$, the row norm of its
+//!   Jacobian, so that $|C_i| / \lVert (C_q)_i\rVert_\infty$ is, to first order, the
+//!   distance of $q$ from the constraint's surface in the units of $q$.
+//!
+//! A holonomic constraint is met when that distance is within the relative tolerance of
+//! $s_q$: $|C_i| \le \varepsilon\,\lVert (C_q)_i\rVert_\infty\, s_q$. Changing the unit
+//! of a constraint scales both sides by the same factor, changing the unit of length
+//! scales $C_i$ (or $(C_q)_i$) and $s_q$ together, and a mass unit does not enter.
+//! Solves and singularity tests of square matrices equilibrate rows and columns (see
+//! [`crate::linalg::dense`]).
+
+use crate::linalg::inf_norm;
+
+/// The size of the coordinates, $\lVert q\rVert_\infty$.
+pub(crate) fn coordinate_size(q: &[f64]) -> f64 {
+    inf_norm(q)
+}
+
+/// The largest residual that row `row` (length $n$) of the Jacobian lets a met
+/// constraint keep: $\varepsilon\,\lVert (C_q)_i\rVert_\infty\, s_q$.
+pub(crate) fn residual_bound(row: &[f64], tolerance: f64, size: f64) -> f64 {
+    tolerance * inf_norm(row) * size
+}
+
+/// The constraints of `c` not met to the relative `tolerance` (see the module docs),
+/// with `jacobian` the dense row-major $C_q$ (at least `c.len()` rows of length `n`) and
+/// `size` the size of $q$; a NaN residual is never met.
+pub(crate) fn unmet<'a>(
+    c: &'a [f64],
+    jacobian: &'a [f64],
+    n: usize,
+    tolerance: f64,
+    size: f64,
+) -> impl Iterator<Item = usize> + 'a {
+    c.iter().enumerate().filter_map(move |(i, ci)| {
+        let bound = residual_bound(&jacobian[i * n..(i + 1) * n], tolerance, size);
+        (ci.is_nan() || ci.abs() > bound).then_some(i)
+    })
+}
+
+/// Whether every constraint of `c` is met (see [`unmet`]).
+pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, size: f64) -> bool {
+    unmet(c, jacobian, n, tolerance, size).next().is_none()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Cartesian pendulum's rod `x² + y² − l²` at a state off the circle by a
+    /// relative 1e-13: met at a tolerance of 1e-12 and not at 1e-14 in every unit of
+    /// length (the residual grows as l², the row norm and the size as l).
+    #[test]
+    fn the_rod_is_met_alike_in_every_unit_of_length() {
+        for l in [1e-3, 1.0, 1e3] {
+            let (x, y) = (l * (1.0 + 1e-13), 0.0);
+            let c = [x * x + y * y - l * l];
+            let jacobian = [2.0 * x, 2.0 * y];
+            let size = coordinate_size(&[x, y]);
+            assert!(all_met(&c, &jacobian, 2, 1e-12, size), "l = {l}");
+            assert!(!all_met(&c, &jacobian, 2, 1e-14, size), "l = {l}");
+        }
+    }
+
+    #[test]
+    fn a_nan_residual_is_never_met() {
+        assert_eq!(
+            unmet(&[f64::NAN], &[1.0], 1, 1.0, 1.0).collect::<Vec<_>>(),
+            [0]
+        );
+    }
+}
