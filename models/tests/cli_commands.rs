@@ -175,6 +175,47 @@ fn simulate_energy_is_null_for_a_driven_model() {
 }
 
 #[test]
+fn simulate_repeat_reports_the_same_run() {
+    let args = [
+        "simulate", "andrews", "--rtol", "1e-8", "--atol", "1e-8", "--json",
+    ];
+    let once: Value = serde_json::from_str(&stdout(&pfaff(&args))).unwrap();
+    let out = pfaff(&[&args[..], &["--repeat", "3"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let thrice: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    check_keys(&thrice, false);
+    // The runs are deterministic: the same work and the same final state.
+    assert_eq!(once["stats"], thrice["stats"]);
+    assert_eq!(once["final"], thrice["final"]);
+    assert!(thrice["wall_seconds"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn rhs_time_reports_the_cost_of_one_evaluation() {
+    let out = pfaff(&["rhs-time", "andrews", "--calls", "1000", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    assert_eq!(
+        keys,
+        ["batches", "calls", "model", "seconds_per_call", "solver"]
+    );
+    assert_eq!(v["model"], "andrews");
+    assert_eq!(v["calls"], 1000);
+    // 7 coordinates and 6 constraints: the augmented system is small enough for the
+    // dense path (DEFAULT_CROSSOVER).
+    assert_eq!(v["solver"], "dense");
+    let s = v["seconds_per_call"].as_f64().unwrap();
+    assert!(s > 0.0 && s < 1e-3, "{s}");
+    let text = stdout(&pfaff(&["rhs-time", "pendulum", "--calls", "10"]));
+    assert!(
+        text.starts_with("pendulum: index-1 right-hand side") && text.contains("us per call"),
+        "{text}"
+    );
+}
+
+#[test]
 fn simulate_failure_reports_the_error_and_the_partial_run() {
     // A massless sleigh: the augmented matrix is singular from the start.
     let out = pfaff(&[

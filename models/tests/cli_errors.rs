@@ -77,6 +77,11 @@ fn negative_or_invalid_numbers() {
         "--step",
         "-0.1",
     ]);
+    let err = bad(&["simulate", "pendulum", "--repeat", "0"]);
+    assert!(err.contains("--repeat 0"), "{err}");
+    let err = bad(&["rhs-time", "pendulum", "--calls", "0"]);
+    assert!(err.contains("--calls 0"), "{err}");
+    bad(&["rhs-time", "andrew"]);
 }
 
 #[test]

@@ -70,7 +70,9 @@ pub struct DynamicsParams {
     /// path runs).
     pub residual_tolerance: f64,
     /// Relative residual of the redundant rows, $\max_D|J_D\ddot q - \gamma_D|$ over
-    /// $\max_D(\lVert J_D\rVert\lVert\ddot q\rVert + |\gamma_D|)$, above which
+    /// $\max_D(\lVert J_D\rVert(\lVert\ddot q\rVert + a_Q) + |\gamma_D|)$ with
+    /// $a_Q = \max_j |Q_j|/M_{jj}$ (the accelerations the forces alone would give, the
+    /// scale at a static equilibrium where $\ddot q = 0$), above which
     /// they count as inconsistent ([`DynamicsError::InconsistentRedundant`]). Below it
     /// the solution is the least-squares one described in the module docs. A kinematic
     /// analysis at an exact configuration keeps the default $10^{-8}$; a simulation,
@@ -417,13 +419,23 @@ impl Dynamics {
         lu.solve_vec(&mut x);
         let qdd = &x[..n];
 
-        // The redundant rows must be satisfied by q̈ too.
+        // The redundant rows must be satisfied by q̈ too, relative to the accelerations
+        // at play: those of the solution and those the forces alone would give,
+        // max_j |Q_j| / M_jj (at a static equilibrium q̈ = 0 while the forces are not).
+        let forced = info
+            .mass_pattern
+            .iter()
+            .zip(&ws.mass_values)
+            .filter(|(&(r, c), &m)| r == c && m != 0.0)
+            .fold(0.0_f64, |a, (&(r, _), &m)| {
+                a.max((self.b[r as usize] / m).abs())
+            });
         let mut residual = 0.0_f64;
         let mut scale = 0.0_f64;
         for &d in &rows_d {
             let jd = row(d);
             residual = residual.max((dot(jd, qdd) - self.b[n + d]).abs());
-            scale = scale.max(inf_norm(jd) * inf_norm(qdd) + self.b[n + d].abs());
+            scale = scale.max(inf_norm(jd) * (inf_norm(qdd) + forced) + self.b[n + d].abs());
         }
         if residual.is_nan()
             || residual > self.params.redundant_tolerance * scale.max(f64::MIN_POSITIVE)

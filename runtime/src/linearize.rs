@@ -24,8 +24,13 @@
 //!
 //! **Difference step.** Column $j$ of $A$ is the central difference
 //! $(f(y + h_j e_j) - f(y - h_j e_j)) / 2h_j$ with
-//! $h_j = \varepsilon^{1/3}(1 + |y_j|)$, $\varepsilon$ = [`f64::EPSILON`]
-//! (so $h_j \approx 6\cdot10^{-6}$ for unit-sized states). The truncation error is
+//! $h_j = \varepsilon^{1/3}\max(|y_j|, s_j)$, $\varepsilon$ = [`f64::EPSILON`], where
+//! $s_j$ is the scale of the component's kind, so that the steps follow the units of
+//! the model: $\lVert q\rVert_\infty$ for the positions, and for the velocities the
+//! larger of $\lVert\dot q\rVert_\infty$ and $\lVert q\rVert_\infty\omega$, with
+//! $\omega^2 = \max|\partial\ddot\gamma/\partial p|$ from the position columns (a
+//! pendulum at rest: $\sqrt{g l}$). For unit-sized states
+//! $h_j \approx 6\cdot10^{-6}$ relative. The truncation error is
 //! $h_j^2 |f'''|/6 \approx 6\cdot10^{-12}|f'''|$ and the rounding error
 //! $\approx \varepsilon |f| / h_j \approx 4\cdot10^{-11}|f|$; $\varepsilon^{1/3}$ balances
 //! the two. K1 runs to a relative tolerance of $10^{-14}$ so that Newton's residual
@@ -38,6 +43,7 @@
 
 use crate::dynamics::{Dynamics, DynamicsError, DynamicsParams};
 use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams};
+use crate::linalg::inf_norm;
 use crate::partition::{Partition, PartitionError, PartitionParams, Preferences};
 use crate::workspace::{check_state, EvalError, Workspace};
 use crate::Mechanism;
@@ -45,7 +51,8 @@ use crate::Mechanism;
 /// Tuning of [`linearize`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearizeParams {
-    /// Relative difference step $h_j / (1 + |y_j|)$; default $\varepsilon^{1/3}$.
+    /// Relative difference step $h_j / \max(|y_j|, s_j)$ (see the module docs); default
+    /// $\varepsilon^{1/3}$.
     pub relative_step: f64,
     /// Position and velocity analysis (the default Newton tolerance is $10^{-14}$).
     pub kinematics: KinematicsParams,
@@ -236,14 +243,47 @@ impl<M: Mechanism + ?Sized> Reduced<'_, M> {
         Ok(())
     }
 
-    /// Central-difference Jacobian with steps `scale` × $h_j$ (row-major).
-    fn jacobian(&mut self, y0: &[f64], rel: f64, scale: f64) -> Result<Vec<f64>, LinearizeError> {
-        let d = y0.len();
-        let mut a = vec![0.0; d * d];
+    /// The difference steps $h_j = \epsilon_r s_j$ (see the module docs): positions on
+    /// the size of $q$, velocities on the size of $\dot q$ or the velocity scale
+    /// $\lVert q\rVert_\infty\,\omega$ of the position columns,
+    /// $\omega^2 = \max|\partial\ddot\gamma/\partial p|$.
+    fn steps(&mut self, y0: &[f64], rel: f64) -> Result<Vec<f64>, LinearizeError> {
+        let (d, np) = (y0.len(), self.p.len());
+        let positive = |x: f64, fallback: f64| {
+            if x > 0.0 && x.is_finite() {
+                x
+            } else {
+                fallback
+            }
+        };
+        let size_q = positive(inf_norm(&self.q0), 1.0);
+        let mut h: Vec<f64> = y0.iter().map(|y| rel * y.abs().max(size_q)).collect();
+        let a = self.columns(y0, &h[..np], 1.0)?;
+        let omega2 = (np..d)
+            .flat_map(|i| (0..np).map(move |j| (i, j)))
+            .fold(0.0_f64, |m, (i, j)| m.max(a[i * np + j].abs()));
+        let speed = inf_norm(&self.qd0).max(size_q * omega2.sqrt());
+        let speed = positive(speed, size_q);
+        for j in np..d {
+            h[j] = rel * y0[j].abs().max(speed);
+        }
+        Ok(h)
+    }
+
+    /// Central-difference Jacobian with steps `scale` × `h` (row-major).
+    fn jacobian(&mut self, y0: &[f64], h: &[f64], scale: f64) -> Result<Vec<f64>, LinearizeError> {
+        self.columns(y0, h, scale)
+    }
+
+    /// The first `h.len()` columns of the central-difference Jacobian (row-major,
+    /// `d × h.len()`) with steps `scale` × `h`.
+    fn columns(&mut self, y0: &[f64], h: &[f64], scale: f64) -> Result<Vec<f64>, LinearizeError> {
+        let (d, c) = (y0.len(), h.len());
+        let mut a = vec![0.0; d * c];
         let (mut fp, mut fm) = (vec![0.0; d], vec![0.0; d]);
         let mut y = y0.to_vec();
-        for j in 0..d {
-            let h = scale * rel * (1.0 + y0[j].abs());
+        for j in 0..c {
+            let h = scale * h[j];
             // Use the representable step so that the divisor matches the perturbation.
             let (yp, ym) = (y0[j] + h, y0[j] - h);
             y[j] = yp;
@@ -252,7 +292,7 @@ impl<M: Mechanism + ?Sized> Reduced<'_, M> {
             self.eval(&y, &mut fm)?;
             y[j] = y0[j];
             for i in 0..d {
-                a[i * d + j] = (fp[i] - fm[i]) / (yp - ym);
+                a[i * c + j] = (fp[i] - fm[i]) / (yp - ym);
             }
         }
         Ok(a)
@@ -362,8 +402,9 @@ pub fn linearize<M: Mechanism + ?Sized>(
         lambda: vec![0.0; m],
     };
     let y0 = reduced.state();
-    let a_h = reduced.jacobian(&y0, rel, 1.0)?;
-    let a_2h = reduced.jacobian(&y0, rel, 2.0)?;
+    let h = reduced.steps(&y0, rel)?;
+    let a_h = reduced.jacobian(&y0, &h, 1.0)?;
+    let a_2h = reduced.jacobian(&y0, &h, 2.0)?;
     let error_estimate = a_h
         .iter()
         .zip(&a_2h)

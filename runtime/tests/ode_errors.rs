@@ -197,6 +197,12 @@ fn bad_arguments_are_errors() {
         Rk4::new(1, 0.0),
         Err(OdeError::InvalidStepSize { .. })
     ));
+    // rtol above 1 asks for no correct digit (issue 9: rtol 1e150 ran a million
+    // attempts at t = 0).
+    assert!(matches!(
+        Dopri5::new(1, OdeOptions::with_tol(1e150)),
+        Err(OdeError::InvalidTolerance { .. })
+    ));
     assert!(matches!(
         Dopri5::new(1, OdeOptions::with_tol(-1.0)),
         Err(OdeError::InvalidTolerance { .. })

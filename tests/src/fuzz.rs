@@ -21,7 +21,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use proc_macro2::{Group, Literal, Punct, Spacing, TokenStream, TokenTree};
+use proc_macro2::{Delimiter, Group, Literal, Punct, Spacing, TokenStream, TokenTree};
 use quote::{quote, ToTokens};
 
 use crate::accuracy::util::Rng;
@@ -70,7 +70,27 @@ fn corpus() -> Vec<(String, TokenStream)> {
     out
 }
 
-/// Every identifier of the corpus (names, methods, keywords), deduplicated.
+/// The brace groups directly inside the module's body: function bodies and
+/// `Coordinate { .. }` literals, where the expressions are.
+fn bodies(module: &TokenStream) -> Vec<Group> {
+    let Some(TokenTree::Group(body)) = module
+        .clone()
+        .into_iter()
+        .filter(|tt| matches!(tt, TokenTree::Group(g) if g.delimiter() == Delimiter::Brace))
+        .last()
+    else {
+        return Vec::new();
+    };
+    body.stream()
+        .into_iter()
+        .filter_map(|tt| match tt {
+            TokenTree::Group(g) if g.delimiter() == Delimiter::Brace => Some(g),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every identifier of the corpus's expressions (names, methods), deduplicated.
 fn identifiers(corpus: &[(String, TokenStream)]) -> Vec<String> {
     fn walk(ts: &TokenStream, out: &mut Vec<String>) {
         for tt in ts.clone() {
@@ -83,7 +103,9 @@ fn identifiers(corpus: &[(String, TokenStream)]) -> Vec<String> {
     }
     let mut out = Vec::new();
     for (_, ts) in corpus {
-        walk(ts, &mut out);
+        for g in bodies(ts) {
+            walk(&g.stream(), &mut out);
+        }
     }
     out.sort();
     out.dedup();
@@ -118,32 +140,43 @@ const CALLS: [&str; 8] = ["sin", "cos", "sqrt", "ln", "exp", "abs", "signum", "a
 /// One mutation of the token list `list` at position `k` (of its own level).
 fn mutate_at(list: &mut Vec<TokenTree>, k: usize, rng: &mut Rng, names: &[String]) {
     let pick = |rng: &mut Rng, n: usize| (rng.next_u64() % n as u64) as usize;
-    match rng.next_u64() % 8 {
-        0 => {
-            let lit: TokenStream = NUMBERS[pick(rng, NUMBERS.len())].parse().unwrap();
-            list[k] = lit.into_iter().next().unwrap();
+    // Weighted towards mutations that keep the expression well-formed, so that a good
+    // share of the cases reaches the derivation and the emitter.
+    match rng.next_u64() % 20 {
+        0..=4 => {
+            // A number where there was one: an extreme value.
+            if let TokenTree::Literal(_) = &list[k] {
+                let lit: TokenStream = NUMBERS[pick(rng, NUMBERS.len())].parse().unwrap();
+                list[k] = lit.into_iter().next().unwrap();
+            }
         }
-        1 => {
-            let name = &names[pick(rng, names.len())];
-            if let Ok(ts) = name.parse::<TokenStream>() {
-                if let Some(tt) = ts.into_iter().next() {
-                    list[k] = tt;
+        5..=7 => {
+            if let TokenTree::Ident(_) = &list[k] {
+                let name = &names[pick(rng, names.len())];
+                if let Ok(ts) = name.parse::<TokenStream>() {
+                    if let Some(tt) = ts.into_iter().next() {
+                        list[k] = tt;
+                    }
                 }
             }
         }
-        2 => {
-            let op = OPERATORS[pick(rng, OPERATORS.len())];
-            list[k] = TokenTree::Punct(Punct::new(op, Spacing::Alone));
+        8..=10 => {
+            if let TokenTree::Punct(p) = &list[k] {
+                if OPERATORS.contains(&p.as_char()) && p.spacing() == Spacing::Alone {
+                    let op = OPERATORS[pick(rng, OPERATORS.len())];
+                    list[k] = TokenTree::Punct(Punct::new(op, Spacing::Alone));
+                }
+            }
         }
-        3 => {
+        11 => {
             list.remove(k);
         }
-        4 => {
+        12 => {
             let tt = list[k].clone();
             list.insert(k, tt);
         }
-        5 if k + 1 < list.len() => list.swap(k, k + 1),
-        6 => {
+        13 if k + 1 < list.len() => list.swap(k, k + 1),
+        14..=16 => {
             // `.f()` after the tree: `x.sin()`.
             let f = proc_macro2::Ident::new(CALLS[pick(rng, CALLS.len())], list[k].span());
             let call = quote!(. #f ());
@@ -189,6 +222,41 @@ fn mutate(ts: &TokenStream, target: &mut usize, rng: &mut Rng, names: &[String])
     list.into_iter().collect()
 }
 
+/// The depth-first index (as counted by [`mutate`]) of a random token tree inside a
+/// random expression group of `ts` (see [`bodies`]).
+fn expression_tree(ts: &TokenStream, rng: &mut Rng) -> Option<usize> {
+    let groups = bodies(ts);
+    if groups.is_empty() {
+        return None;
+    }
+    let chosen = &groups[(rng.next_u64() % groups.len() as u64) as usize];
+    let inside = count(&chosen.stream());
+    if inside == 0 {
+        return None;
+    }
+    // Find the chosen group's own index by walking the stream like `mutate` does.
+    fn find(ts: &TokenStream, target: &Group, index: &mut usize) -> Option<usize> {
+        for tt in ts.clone() {
+            let here = *index;
+            *index += 1;
+            if let TokenTree::Group(g) = &tt {
+                if g.delimiter() == target.delimiter()
+                    && g.span().start() == target.span().start()
+                    && g.stream().to_string() == target.stream().to_string()
+                {
+                    return Some(here);
+                }
+                if let Some(k) = find(&g.stream(), target, index) {
+                    return Some(k);
+                }
+            }
+        }
+        None
+    }
+    let start = find(ts, chosen, &mut 0)?;
+    Some(start + 1 + (rng.next_u64() % inside as u64) as usize)
+}
+
 /// The expansion of `input` and how long it took, or the panic message.
 fn expand(input: &TokenStream) -> (Result<TokenStream, String>, Duration) {
     let start = Instant::now();
@@ -203,27 +271,31 @@ fn expand(input: &TokenStream) -> (Result<TokenStream, String>, Duration) {
     (out, start.elapsed())
 }
 
-/// Checks one case; the error says what failed.
-fn check(input: &TokenStream) -> Result<(), String> {
+/// Checks one case; the error says what failed. `Ok(true)` when the case expanded to a
+/// model (no `compile_error!`).
+fn check(input: &TokenStream) -> Result<bool, String> {
     let (out, took) = expand(input);
     let out = out.map_err(|panic| format!("the generator panicked: {panic}"))?;
     if took > BUDGET {
         return Err(format!("expansion took {took:?}, more than {BUDGET:?}"));
     }
-    syn::parse2::<syn::File>(out.clone())
+    let file = syn::parse2::<syn::File>(out.clone())
         .map_err(|e| format!("the expansion does not parse ({e}): {out}"))?;
-    Ok(())
+    let error = file.items.iter().any(|item| {
+        matches!(item, syn::Item::Macro(m) if m.mac.path.segments.last().is_some_and(|s| s.ident == "compile_error"))
+    });
+    Ok(!error)
 }
 
 /// Runs cases from `seed` until `cases` are done or `time` has passed; returns the
-/// number run.
-fn run(seed: u64, cases: u64, time: Duration) -> u64 {
+/// number run and how many of them expanded to a model.
+fn run(seed: u64, cases: u64, time: Duration) -> (u64, u64) {
     let corpus = corpus();
     assert!(corpus.len() > 10, "corpus of {} modules", corpus.len());
     let names = identifiers(&corpus);
     let mut rng = Rng::new(seed);
     let start = Instant::now();
-    let mut done = 0;
+    let (mut done, mut models) = (0, 0);
     while done < cases && start.elapsed() < time {
         let (origin, base) = &corpus[(rng.next_u64() % corpus.len() as u64) as usize];
         let mut ts = base.clone();
@@ -232,15 +304,24 @@ fn run(seed: u64, cases: u64, time: Duration) -> u64 {
             if n == 0 || n > 4 * count(base) + 64 {
                 break;
             }
-            let mut target = (rng.next_u64() % n as u64) as usize;
+            // Mostly inside the expressions; sometimes anywhere (the item structure).
+            let mut target = if rng.next_u64() % 8 == 0 {
+                (rng.next_u64() % n as u64) as usize
+            } else {
+                match expression_tree(&ts, &mut rng) {
+                    Some(k) => k,
+                    None => continue,
+                }
+            };
             ts = mutate(&ts, &mut target, &mut rng, &names);
         }
-        if let Err(e) = check(&ts) {
-            panic!("seed {seed}, case {done} (from `{origin}`): {e}\ninput: {ts}");
+        match check(&ts) {
+            Ok(model) => models += u64::from(model),
+            Err(e) => panic!("seed {seed}, case {done} (from `{origin}`): {e}\ninput: {ts}"),
         }
         done += 1;
     }
-    done
+    (done, models)
 }
 
 /// The unmutated corpus expands within the budget and parses.
@@ -250,6 +331,10 @@ fn corpus_expands() {
     for (name, ts) in &corpus {
         check(ts).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
+    // The built-in models expand to models.
+    for (name, ts) in crate::sources::model_sources() {
+        assert_eq!(check(&ts), Ok(true), "{name}");
+    }
     // Both sources are represented.
     assert!(corpus.iter().any(|(n, _)| n == "andrews"));
     assert!(corpus.iter().any(|(n, _)| n == "kinetic_not_quadratic"));
@@ -258,8 +343,11 @@ fn corpus_expands() {
 /// A few hundred mutated cases with a fixed seed, with every test run.
 #[test]
 fn smoke() {
-    let done = run(0x5EED, 300, Duration::from_secs(60));
+    let (done, models) = run(0x5EED, 300, Duration::from_secs(60));
     assert_eq!(done, 300);
+    // The mutations keep a share of the cases valid, which reach every stage (half
+    // the corpus are compile-fail cases, invalid by design).
+    assert!(models > 15, "{models} of {done} cases expanded to a model");
 }
 
 /// The CI campaign (see the module docs).
@@ -278,7 +366,9 @@ fn campaign() {
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(1, |d| d.as_secs())
         });
-    let done = run(seed, u64::MAX, Duration::from_secs(seconds));
-    println!("fuzz: {done} cases in {seconds} s from seed {seed}, no failure");
+    let (done, models) = run(seed, u64::MAX, Duration::from_secs(seconds));
+    println!(
+        "fuzz: {done} cases ({models} expanded to a model) in {seconds} s from seed {seed}, no failure"
+    );
     assert!(done > 0);
 }

@@ -34,6 +34,9 @@ pub enum Command {
     /// Final error against work for every formulation and integrator over a sweep of
     /// tolerances.
     WorkPrecision(WorkPrecisionArgs),
+    /// Time one index-1 right-hand side (M, Q, C_q, gamma and the solve of the augmented
+    /// system) at the initial state.
+    RhsTime(RhsTimeArgs),
 }
 
 /// How the constrained equations become an ODE.
@@ -175,6 +178,10 @@ pub struct SimulateArgs {
     /// Print one JSON object on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Run the simulation N times and report the best wall time (for timing; the runs
+    /// are identical otherwise).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub repeat: usize,
 }
 
 /// Arguments of `pfaff linearize`.
@@ -207,6 +214,24 @@ pub struct WorkPrecisionArgs {
     /// method.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+}
+
+/// Arguments of `pfaff rhs-time`.
+#[derive(Debug, Args)]
+pub struct RhsTimeArgs {
+    /// The model (see `pfaff list`).
+    pub model: String,
+    #[command(flatten)]
+    pub state: StateArgs,
+    /// Evaluations per timed batch.
+    #[arg(long, value_name = "N", default_value_t = 100_000)]
+    pub calls: usize,
+    /// Timed batches; the best one is reported.
+    #[arg(long, value_name = "B", default_value_t = 5)]
+    pub batches: usize,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[cfg(test)]

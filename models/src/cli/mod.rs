@@ -8,6 +8,7 @@ mod linearize;
 mod list;
 mod plot;
 mod precision;
+mod rhs_time;
 mod scene;
 mod setup;
 mod simulate;
@@ -40,6 +41,7 @@ fn default_scene() -> SimulateArgs {
         plot: Some("pfaff-andrews.svg".into()),
         samples: 500,
         json: false,
+        repeat: 1,
     }
 }
 
@@ -62,6 +64,7 @@ fn dispatch(cli: &Cli) -> Result<(), CliError> {
         Some(Command::Simulate(args)) => simulate::command(args),
         Some(Command::Linearize(args)) => linearize::command(args),
         Some(Command::WorkPrecision(args)) => precision::command(args),
+        Some(Command::RhsTime(args)) => rhs_time::command(args),
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pfaff::sim::{min_step, Formulation, Method, Run, SimErrorKind, Simulation};
+use pfaff::sim::{min_step, Formulation, Method, Run, SimError, SimErrorKind, Simulation};
 use pfaff::{Mechanism, MechanismExt};
 use serde_json::{json, Map, Value};
 
@@ -82,6 +82,9 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
     if args.samples == 0 {
         return Err(usage("invalid --samples 0: expected at least 1"));
     }
+    if args.repeat == 0 {
+        return Err(usage("invalid --repeat 0: expected at least 1"));
+    }
     let method = match args.integrator {
         IntegratorArg::Rk4 => Method::Rk4 {
             h: step.unwrap_or(t_end / 1000.0),
@@ -104,13 +107,46 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
 pub struct Outcome {
     pub run: Run,
     pub error: Option<SimErrorKind>,
+    /// The wall time of the run, the best of `--repeat` runs.
     pub wall: Duration,
     pub notes: Vec<String>,
 }
 
-/// Runs the simulation of `req` on `model`.
+/// Runs the simulation of `req` on `model`, `--repeat` times from the same initial
+/// state: the outcome is the last run's, with the best wall time. A failed run ends the
+/// repetitions.
 pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outcome, CliError> {
     let init = setup::assemble(model, &req.args.state, &[], &[])?;
+    let (mut result, mut wall) = run_once(model, req, &init.q, &init.qd, dense);
+    for _ in 1..req.args.repeat {
+        if result.is_err() {
+            break;
+        }
+        let (next, elapsed) = run_once(model, req, &init.q, &init.qd, dense);
+        result = next;
+        wall = wall.min(elapsed);
+    }
+    let (run, error) = match result {
+        Ok(run) => (run, None),
+        Err(e) => (*e.partial, Some(e.kind)),
+    };
+    Ok(Outcome {
+        run,
+        error,
+        wall,
+        notes: req.notes.iter().cloned().chain(init.notes).collect(),
+    })
+}
+
+/// One run from `(q0, qd0)` and its wall time (the run's own: assembly and start-up
+/// excluded).
+fn run_once(
+    model: &dyn Mechanism,
+    req: &Request<'_>,
+    q0: &[f64],
+    qd0: &[f64],
+    dense: bool,
+) -> (Result<Run, SimError>, Duration) {
     let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template("{spinner} t = {msg} s [{bar:40}] {percent}% ({elapsed})")
@@ -124,7 +160,7 @@ pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outc
         .formulation(req.formulation)
         .integrator(req.method)
         .tolerances(req.args.rtol, req.args.atol)
-        .initial_state(&init.q, &init.qd)
+        .initial_state(q0, qd0)
         .on_progress(move |t| {
             // Only runs that last show a bar (indicatif hides it when stderr is not a
             // terminal).
@@ -144,22 +180,7 @@ pub fn run(model: &dyn Mechanism, req: &Request<'_>, dense: bool) -> Result<Outc
     let result = sim.run(t_end);
     drop(sim);
     bar.finish_and_clear();
-    let wall = start.elapsed();
-    let notes = req.notes.iter().cloned().chain(init.notes).collect();
-    Ok(match result {
-        Ok(run) => Outcome {
-            run,
-            error: None,
-            wall,
-            notes,
-        },
-        Err(e) => Outcome {
-            run: *e.partial,
-            error: Some(e.kind),
-            wall,
-            notes,
-        },
-    })
+    (result, start.elapsed())
 }
 
 /// The `kind` of a failure in the JSON report.

@@ -223,3 +223,20 @@ fn a_non_finite_prescription_names_its_quantity_and_time() {
         "{err}"
     );
 }
+
+/// A first step below what the time resolves is raised to `sim::min_step`, so the
+/// restarts after a re-partition (which start with it) do not stop the run (issue 9:
+/// `--step 1e-20` stopped Adams, DOPRI5 and DOP853 at the first re-partition).
+#[test]
+fn a_first_step_the_time_cannot_resolve_is_raised() {
+    let model = pendulum::Model::default();
+    for method in Method::ADAPTIVE {
+        let run = Simulation::new(&model)
+            .integrator(method)
+            .initial_step(1e-20)
+            .run(7.0)
+            .unwrap_or_else(|e| panic!("{}: {e}", method.name()));
+        assert_eq!(run.final_state().unwrap().0, 7.0);
+    }
+    assert!(pfaff::sim::min_step(0.0, 7.0) > 10.0 * f64::EPSILON * 7.0);
+}

@@ -29,6 +29,9 @@ struct Case {
     q0: Vec<f64>,
     qd0: Vec<f64>,
     t_end: f64,
+    /// A configuration of static equilibrium (hanging at rest), where the eigenvalues
+    /// of the linearization do not depend on the coordinates chosen.
+    equilibrium: Vec<f64>,
 }
 
 fn cases() -> Vec<Case> {
@@ -41,6 +44,7 @@ fn cases() -> Vec<Case> {
             q0: vec![1.0, 0.0],
             qd0: vec![0.0, 0.0],
             t_end: 1.5,
+            equilibrium: vec![0.0, -1.0],
         },
         // The parallelogram hanging and swinging clear of its flat configurations
         // (as in `redundant.rs`): angles and lengths, and a redundant constraint.
@@ -64,6 +68,7 @@ fn cases() -> Vec<Case> {
             q0: vec![th, th, th, l * th.cos(), l * th.sin(), 0.0],
             qd0: vec![0.5, 0.5, 0.5, -0.5 * l * th.sin(), 0.5 * l * th.cos(), 0.0],
             t_end: 1.0,
+            equilibrium: vec![-FRAC_PI_2, -FRAC_PI_2, -FRAC_PI_2, 0.0, -l, 0.0],
         },
     ]
 }
@@ -105,8 +110,8 @@ fn scales() -> Vec<Scale> {
 
 const RTOL: f64 = 1e-9;
 
-/// Runs `case` in the units `s` and returns the run.
-fn run(case: &Case, s: Scale, form: Formulation, method: Method) -> Result<Run, String> {
+/// The model of `case` with its parameters and initial state in the units `s`.
+fn scaled(case: &Case, s: Scale) -> (Box<dyn pfaff::Mechanism>, Vec<f64>, Vec<f64>) {
     let entry = pfaff_models::find(case.name).unwrap();
     let mut model = (entry.make)();
     let info = model.info();
@@ -121,6 +126,12 @@ fn run(case: &Case, s: Scale, form: Formulation, method: Method) -> Result<Run, 
     let qd: Vec<f64> = (case.qd0.iter().zip(case.coordinates))
         .map(|(v, &u)| v * s.of(u) / s.time)
         .collect();
+    (model, q, qd)
+}
+
+/// Runs `case` in the units `s` and returns the run.
+fn run(case: &Case, s: Scale, form: Formulation, method: Method) -> Result<Run, String> {
+    let (model, q, qd) = scaled(case, s);
     let form = match form {
         Formulation::Baumgarte { alpha, beta } => Formulation::Baumgarte {
             alpha: alpha / s.time,
@@ -201,4 +212,49 @@ fn dimensionless_trajectories_do_not_depend_on_units() {
         }
     }
     eprintln!("largest difference of the dimensionless states: {worst:.1e}");
+}
+
+/// The linearization about each case's equilibrium: eigenvalues scale as 1/τ (the
+/// difference steps follow the units). Away from an equilibrium the eigenvalues of the
+/// reduced system depend on which coordinates are independent, and that choice may
+/// change with the units of mixed coordinates.
+#[test]
+fn linearizations_do_not_depend_on_units() {
+    let unit = Scale {
+        mass: 1.0,
+        length: 1.0,
+        time: 1.0,
+    };
+    for case in cases() {
+        let at_rest = Case {
+            q0: case.equilibrium.clone(),
+            qd0: vec![0.0; case.equilibrium.len()],
+            equilibrium: Vec::new(),
+            ..case
+        };
+        let lin = |s: Scale| {
+            let (model, q, qd) = scaled(&at_rest, s);
+            pfaff::linearize(model.as_ref(), 0.0, &q, &qd, &[], &Default::default())
+                .unwrap_or_else(|e| panic!("{} {s:?}: {e}", case.name))
+        };
+        let reference = lin(unit);
+        let size = reference
+            .eigenvalues
+            .iter()
+            .fold(0.0_f64, |m, e| m.max(e.re.hypot(e.im)));
+        for s in scales() {
+            let l = lin(s);
+            assert_eq!(l.eigenvalues.len(), reference.eigenvalues.len());
+            for (a, b) in l.eigenvalues.iter().zip(&reference.eigenvalues) {
+                let (re, im) = (a.re * s.time, a.im * s.time);
+                assert!(
+                    (re - b.re).abs().max((im - b.im).abs()) <= 1e-6 * size,
+                    "{} {s:?}: {re} {im} vs {} {}",
+                    at_rest.name,
+                    b.re,
+                    b.im
+                );
+            }
+        }
+    }
 }
