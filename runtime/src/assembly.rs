@@ -194,6 +194,39 @@ fn resolve(
         .collect()
 }
 
+/// Writes the prescribed values into `(q, q̇)` without solving anything (for a
+/// formulation that does not enforce the constraints).
+pub(crate) fn write_prescription(
+    info: &'static crate::Info,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    prescription: &Prescription<'_>,
+) -> Result<(), AssemblyError> {
+    let mut seen = Vec::new();
+    let pos = resolve(
+        info,
+        crate::Quantity::Coordinates,
+        t,
+        prescription.coordinates,
+        &mut seen,
+    )?;
+    let vel = resolve(
+        info,
+        crate::Quantity::Velocities,
+        t,
+        prescription.velocities,
+        &mut seen,
+    )?;
+    for (i, v) in pos {
+        q[i] = v;
+    }
+    for (i, v) in vel {
+        qd[i] = v;
+    }
+    Ok(check_state(info, t, q, Some(qd))?)
+}
+
 impl Kinematics {
     /// Makes $(q, \dot q)$ consistent at time `t`, holding the prescribed values; the
     /// partition used becomes current (it is not counted as a re-partition).

@@ -36,6 +36,7 @@
 use crate::linalg::dense::DenseLu;
 use crate::linalg::elimination::Elimination;
 use crate::linalg::inf_norm;
+use crate::linalg::small::SmallLu;
 use crate::linalg::sparse::SparseKkt;
 use crate::workspace::{
     check_finite, check_len, check_same_model, check_state, scatter_row_major, EvalError, Quantity,
@@ -169,6 +170,9 @@ pub enum DynamicsError {
 pub struct Dynamics {
     params: DynamicsParams,
     info: &'static Info,
+    /// The dense path: partial pivoting first, complete pivoting when its pivots
+    /// suggest a singular matrix.
+    small: Option<SmallLu>,
     dense: Option<DenseLu>,
     sparse: Option<SparseKkt>,
     x: Vec<f64>,
@@ -198,6 +202,7 @@ impl Dynamics {
         Ok(Self {
             params,
             info,
+            small: dense.then(|| SmallLu::new(dim)),
             dense: dense.then(|| DenseLu::new(dim, 1)),
             sparse,
             x: vec![0.0; dim],
@@ -272,6 +277,21 @@ impl Dynamics {
         ws.eval_mass_and_forces(mech, t, q, qd)?;
         ws.eval_jacobian_values(mech, t, q)?;
         ws.eval_gamma(mech, t, q, qd)?;
+        self.solve_evaluated(ws, t, shift, qdd, lambda)
+    }
+
+    /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
+    /// $\gamma$ already evaluated in `ws` (lengths checked by the caller).
+    pub(crate) fn solve_evaluated(
+        &mut self,
+        ws: &mut Workspace,
+        t: f64,
+        shift: Option<&[f64]>,
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<AccelerationStats, DynamicsError> {
+        let info = self.info;
+        let (n, m) = (info.nq(), info.nh() + info.nnh());
         self.b[..n].copy_from_slice(&ws.forces);
         self.b[n..].copy_from_slice(&ws.gamma);
         if let Some(shift) = shift {
@@ -281,7 +301,22 @@ impl Dynamics {
         }
         self.redundant.clear();
 
-        let stats = if let Some(lu) = self.dense.as_mut() {
+        let small = self.small.as_mut().and_then(|lu| {
+            fill_small(lu, info, ws);
+            let ratio = lu.factor().ratio();
+            (ratio > self.params.rank_tolerance).then(|| {
+                self.x.copy_from_slice(&self.b);
+                lu.solve(&mut self.x);
+                AccelerationStats {
+                    path: SolverPath::Dense,
+                    rank: m,
+                    pivot_ratio: ratio,
+                }
+            })
+        });
+        let stats = if small.is_some() {
+            small
+        } else if let Some(lu) = self.dense.as_mut() {
             fill_dense(lu, info, ws, None);
             let ratio = lu.factor().ratio();
             if ratio > self.params.rank_tolerance {
@@ -496,20 +531,19 @@ fn free_list(coordinates: &[&str]) -> String {
     }
 }
 
-/// Writes $\begin{bmatrix}M & J_R^\mathsf{T}\\ J_R & 0\end{bmatrix}$ into `lu`, with
-/// $J_R$ the rows `rows` of $J$ (all rows when `None`).
-fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usize]>) {
+/// Calls `set(i, j, v)` for the non-zero entries of
+/// $\begin{bmatrix}M & J_R^\mathsf{T}\\ J_R & 0\end{bmatrix}$, with $J_R$ the rows
+/// `rows` of $J$ (all rows when `None`).
+fn augmented_entries(
+    info: &Info,
+    ws: &Workspace,
+    rows: Option<&[usize]>,
+    mut set: impl FnMut(usize, usize, f64),
+) {
     let n = info.nq();
     let mh = info.nh();
-    let dim = lu.dim();
-    let mut a = lu.matrix_mut();
-    for j in 0..dim {
-        for i in 0..dim {
-            a[(i, j)] = 0.0;
-        }
-    }
     for (&(r, c), &v) in info.mass_pattern.iter().zip(&ws.mass_values) {
-        a[(r as usize, c as usize)] = v;
+        set(r as usize, c as usize, v);
     }
     // Position of constraint row `i` in the reduced system, if kept.
     let slot = |i: usize| -> Option<usize> {
@@ -525,9 +559,30 @@ fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usiz
     for (pattern, values, offset) in blocks {
         for (&(r, c), &v) in pattern.iter().zip(values.iter()) {
             if let Some(k) = slot(r as usize + offset) {
-                a[(n + k, c as usize)] = v;
-                a[(c as usize, n + k)] = v;
+                set(n + k, c as usize, v);
+                set(c as usize, n + k, v);
             }
         }
     }
+}
+
+/// Writes the augmented matrix with the rows `rows` of $J$ into `lu` (see
+/// [`augmented_entries`]).
+fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usize]>) {
+    let dim = lu.dim();
+    let mut a = lu.matrix_mut();
+    for j in 0..dim {
+        for i in 0..dim {
+            a[(i, j)] = 0.0;
+        }
+    }
+    augmented_entries(info, ws, rows, |i, j, v| a[(i, j)] = v);
+}
+
+/// Writes the augmented matrix into the row-major `lu`.
+fn fill_small(lu: &mut SmallLu, info: &Info, ws: &Workspace) {
+    let dim = lu.dim();
+    let a = lu.matrix_mut();
+    a.fill(0.0);
+    augmented_entries(info, ws, None, |i, j, v| a[i * dim + j] = v);
 }

@@ -346,11 +346,7 @@ impl Workspace {
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, None)?;
         self.eval_jacobian_values(mech, t, q)?;
-        let n = self.info.nq();
-        let split = self.info.nh() * n;
-        let (h, nh) = self.jacobian.split_at_mut(split);
-        scatter_row_major(self.info.holonomic_pattern, &self.cq_values, n, h);
-        scatter_row_major(self.info.nonholonomic_pattern, &self.g_values, n, nh);
+        self.scatter_jacobian();
         Ok(())
     }
 
@@ -478,6 +474,80 @@ impl Workspace {
         )?;
         mech.forces(t, q, qd, &mut self.forces);
         check_finite(Quantity::Forces, t, &self.forces)
+    }
+
+    /// Evaluates, in one call of the model's fused
+    /// [`dynamics_terms`](Mechanism::dynamics_terms), the pattern values of $M$, $C_q$
+    /// and $G$, the forces $Q$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (the dense $J$ is
+    /// not scattered).
+    pub fn eval_dynamics_terms<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<(), EvalError> {
+        self.check_model(mech, q, Some(qd))?;
+        let info = self.info;
+        let mh = info.nh();
+        let (gamma_h, gamma_nh) = self.gamma.split_at_mut(mh);
+        mech.dynamics_terms(
+            t,
+            q,
+            qd,
+            crate::DynamicsTerms {
+                mass: &mut self.mass_values,
+                forces: &mut self.forces,
+                holonomic_jacobian: &mut self.cq_values,
+                holonomic_gamma: gamma_h,
+                nonholonomic_matrix: &mut self.g_values,
+                nonholonomic_gamma: gamma_nh,
+            },
+        );
+        check_finite_pattern(
+            Quantity::MassMatrix,
+            t,
+            info.mass_pattern,
+            &self.mass_values,
+        )?;
+        check_finite(Quantity::Forces, t, &self.forces)?;
+        check_finite_pattern(
+            Quantity::HolonomicJacobian,
+            t,
+            info.holonomic_pattern,
+            &self.cq_values,
+        )?;
+        check_finite_pattern(
+            Quantity::NonholonomicMatrix,
+            t,
+            info.nonholonomic_pattern,
+            &self.g_values,
+        )?;
+        check_finite(Quantity::HolonomicGamma, t, &self.gamma[..mh])?;
+        check_finite(Quantity::NonholonomicGamma, t, &self.gamma[mh..]).map_err(|e| match e {
+            EvalError::NonFinite {
+                quantity,
+                t,
+                row,
+                col,
+                value,
+            } => EvalError::NonFinite {
+                quantity,
+                t,
+                row: row + mh,
+                col,
+                value,
+            },
+            other => other,
+        })
+    }
+
+    /// Scatters the pattern values of $C_q$ and $G$ into the dense $J$.
+    pub(crate) fn scatter_jacobian(&mut self) {
+        let n = self.info.nq();
+        let (h, nh) = self.jacobian.split_at_mut(self.info.nh() * n);
+        scatter_row_major(self.info.holonomic_pattern, &self.cq_values, n, h);
+        scatter_row_major(self.info.nonholonomic_pattern, &self.g_values, n, nh);
     }
 
     /// The dense row-major $J = [C_q; G]$ of the last [`Workspace::eval_jacobian`].

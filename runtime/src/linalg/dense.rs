@@ -214,24 +214,6 @@ pub(crate) fn power_of_two_inverse(x: f64) -> f64 {
     2.0_f64.powi(e)
 }
 
-/// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
-/// into `lu`, factors it and returns the pivot ratio.
-pub(crate) fn gram_factor(lu: &mut DenseLu, a: &[f64], rows: &[usize], n: usize) -> f64 {
-    {
-        let mut g = lu.matrix_mut();
-        for (i, &ri) in rows.iter().enumerate() {
-            let ri = &a[ri * n..(ri + 1) * n];
-            for (k, &rk) in rows[..=i].iter().enumerate() {
-                let rk = &a[rk * n..(rk + 1) * n];
-                let v: f64 = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
-                g[(i, k)] = v;
-                g[(k, i)] = v;
-            }
-        }
-    }
-    lu.factor().ratio()
-}
-
 /// Whether a permutation is odd: $n$ minus its number of cycles, each cycle counted at
 /// its smallest index (quadratic, but allocation-free; the matrices are small).
 fn odd(perm: &[usize]) -> bool {

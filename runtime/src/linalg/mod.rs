@@ -5,6 +5,8 @@
 //!   and the rank-revealing search for redundant constraints).
 //! - [`dense`]: a reusable dense $LU$ with complete pivoting (faer), allocation-free
 //!   after construction.
+//! - [`small`]: $LU$ with partial pivoting and Cholesky for the small systems of one
+//!   evaluation, without a general solver's set-up.
 //! - [`sparse`]: the sparse augmented matrix assembled from the patterns of
 //!   [`Info`](crate::Info), with a symbolic $LU$ computed once.
 //!
@@ -12,6 +14,7 @@
 
 pub(crate) mod dense;
 pub(crate) mod elimination;
+pub(crate) mod small;
 pub(crate) mod sparse;
 
 /// $\lVert x\rVert_\infty$; `NaN` entries propagate (so callers detect them).

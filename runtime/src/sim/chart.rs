@@ -22,9 +22,10 @@
 //!
 //! Invariant: no allocation after [`Chart::new`] (except when building an error).
 
-use crate::linalg::dense::{gram_factor, DenseLu};
+use super::point::Point;
 use crate::linalg::inf_norm;
-use crate::workspace::{EvalError, Workspace};
+use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::workspace::EvalError;
 use crate::Mechanism;
 
 /// Fraction of the integrator's tolerance the Newton iteration leaves as error.
@@ -43,9 +44,6 @@ const DIVERGENCE: f64 = 0.9;
 /// Contraction rate assumed when none has been measured: forces a second update,
 /// which measures it.
 const UNKNOWN_RATE: f64 = 0.5;
-
-/// Pivot ratio below which $N N^\mathsf{T}$ counts as singular.
-pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
 
 /// The outcome of a failed correction.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,7 +73,7 @@ pub(crate) struct Chart {
     /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows`.
     normals: Vec<f64>,
     /// $N N^\mathsf{T}$, factored.
-    gram: DenseLu,
+    gram: SmallCholesky,
     /// Normal coordinates of the current update.
     mu: Vec<f64>,
     /// Measured contraction rate per unit distance from the anchor.
@@ -91,19 +89,11 @@ impl Chart {
         Self {
             anchor: vec![0.0; n],
             normals: vec![0.0; m * n],
-            gram: DenseLu::new(r, 1),
+            gram: SmallCholesky::new(r),
             mu: vec![0.0; r],
             rate_per_distance: None,
             rtol,
             atol,
-        }
-    }
-
-    /// Resizes for `r` rows (after assembly dropped redundant ones; allocates).
-    pub fn resize(&mut self, r: usize) {
-        if self.mu.len() != r {
-            self.gram = DenseLu::new(r, 1);
-            self.mu = vec![0.0; r];
         }
     }
 
@@ -112,38 +102,51 @@ impl Chart {
         self.atol + self.rtol * x.abs()
     }
 
-    /// Anchors the chart at `q` (on the manifold), whose dense $J$ is in `ws` (its rows
-    /// `rows` are taken); returns the pivot ratio of $N N^\mathsf{T}$.
-    pub fn anchor(&mut self, ws: &Workspace, q: &[f64], rows: &[usize]) -> f64 {
-        self.anchor.copy_from_slice(q);
-        self.normals.copy_from_slice(ws.jacobian());
-        gram_factor(&mut self.gram, &self.normals, rows, q.len())
+    /// Anchors the chart at the current positions of `p` (on the manifold); returns
+    /// the pivot ratio of $N N^\mathsf{T}$.
+    pub fn anchor<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<f64, EvalError> {
+        self.normals.copy_from_slice(p.dense_jacobian(t)?);
+        self.anchor.copy_from_slice(&p.q);
+        if self.mu.len() != p.rows_h {
+            // Assembly dropped redundant rows (allocates, once).
+            self.gram = SmallCholesky::new(p.rows_h);
+            self.mu = vec![0.0; p.rows_h];
+        }
+        let n = p.q.len();
+        Ok(gram_cholesky(
+            &mut self.gram,
+            &self.normals,
+            &p.rows[..p.rows_h],
+            n,
+        ))
     }
 
-    /// Moves `q` along the anchor's normals onto $C_R(q, t) = 0$, to the integrator's
-    /// tolerance (see the module docs); returns the number of updates. `rows` are the
-    /// holonomic rows of the chart.
+    /// Moves the positions of `p` along the anchor's normals onto $C_R(q, t) = 0$
+    /// ($R$: the holonomic rows of the projections), to the integrator's tolerance (see
+    /// the module docs); returns the number of updates.
     pub fn correct<M: Mechanism + ?Sized>(
         &mut self,
-        mech: &M,
-        ws: &mut Workspace,
+        p: &mut Point<'_, M>,
         t: f64,
-        q: &mut [f64],
-        rows: &[usize],
     ) -> Result<usize, ChartFailure> {
-        let n = q.len();
-        let distance = q
-            .iter()
-            .zip(&self.anchor)
-            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        let n = p.q.len();
+        let rows_h = p.rows_h;
+        let distance =
+            p.q.iter()
+                .zip(&self.anchor)
+                .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
         let mut rate = self
             .rate_per_distance
             .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
-        let floor = 8.0 * f64::EPSILON * inf_norm(q);
+        let floor = 8.0 * f64::EPSILON * inf_norm(&p.q);
         let mut previous: Option<f64> = None;
         for iteration in 0..=MAX_ITERATIONS {
-            ws.eval_constraints(mech, t, q)?;
-            let c = ws.constraints();
+            p.constraints(t)?;
+            let (c, rows) = (p.ws.constraints(), &p.rows[..rows_h]);
             let residual = rows.iter().fold(0.0_f64, |a, &i| a.max(c[i].abs()));
             if !residual.is_finite() {
                 return Err(ChartFailure::Newton {
@@ -163,10 +166,10 @@ impl Chart {
             for (mu, &i) in self.mu.iter_mut().zip(rows) {
                 *mu = c[i];
             }
-            self.gram.solve_vec(&mut self.mu);
+            self.gram.solve(&mut self.mu);
             let mut step = 0.0_f64;
             let mut weighted = 0.0_f64;
-            for (j, qj) in q.iter_mut().enumerate() {
+            for (j, qj) in p.q.iter_mut().enumerate() {
                 let dq: f64 = -self
                     .mu
                     .iter()

@@ -18,12 +18,14 @@
 use std::time::Instant;
 
 use super::error::{SimError, SimErrorKind};
+use super::formulation::Correction;
 use super::stepper::Stepper;
-use super::system::MechSystem;
+use super::system::System;
 use super::trajectory::{Monitors, Run, Stats, Trajectory};
 use super::{Formulation, Output, Simulation};
+use crate::assembly::write_prescription;
 use crate::kinematics::KinematicsError;
-use crate::ode::{OdeError, OdeOptions, Tolerances};
+use crate::ode::{OdeError, OdeOptions, OdeSystem, Tolerances};
 use crate::workspace::EvalError;
 use crate::{
     AssemblyError, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
@@ -76,7 +78,7 @@ fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErr
 }
 
 struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
-    sys: MechSystem<'m, M>,
+    sys: System<'m, M>,
     traj: Trajectory,
     monitors: Monitors,
     started: Instant,
@@ -87,11 +89,9 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     /// Monitors at the current full state; returns the violations.
     fn observe(&mut self, t: f64) -> Result<(f64, f64, f64), SimErrorKind> {
-        let v = self.sys.violations(t).map_err(SimErrorKind::from_eval)?;
-        let info = self.sys.info;
-        let energy = info
-            .conservative
-            .then(|| self.sys.mech.energy(t, &self.sys.q, &self.sys.qd));
+        let p = &mut self.sys.point;
+        let v = p.violations(t).map_err(SimErrorKind::from_eval)?;
+        let energy = p.info.conservative.then(|| p.mech.energy(t, &p.q, &p.qd));
         self.monitors.observe(v, energy);
         if energy.is_some() {
             self.monitors.energy_final = energy;
@@ -101,32 +101,25 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
 
     /// Records a row at the current full state.
     fn record(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        self.sys.accelerations(t)?;
+        self.sys.form.accelerations(&mut self.sys.point, t)?;
         let v = self.observe(t)?;
-        let energy = self
-            .monitors
-            .energy_final
-            .filter(|_| self.sys.info.conservative);
-        self.traj.push(
-            t,
-            &self.sys.q,
-            &self.sys.qd,
-            &self.sys.lambda,
-            v.0,
-            v.1.max(v.2),
-            energy,
-        );
+        let p = &self.sys.point;
+        let energy = self.monitors.energy_final.filter(|_| p.info.conservative);
+        self.traj
+            .push(t, &p.q, &p.qd, &p.lambda, v.0, v.1.max(v.2), energy);
         Ok(())
     }
 
     /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
-    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state: those that lock the mechanism
-    /// when an iteration stalls on a singular Jacobian with a small residual.
+    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state:
+    /// those that lock the mechanism when an iteration stalls on a singular Jacobian
+    /// with a small residual.
     fn nearly_dependent(&mut self) -> Vec<&'static str> {
-        let sys = &mut self.sys;
+        let p = &mut self.sys.point;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
         };
+        p.invalidate();
         // The weakest rows first: a stall near a fold (a slider at its reach) leaves a
         // pivot ratio of a few 1e-3 at the last accepted state.
         for tolerance in NEAR_SINGULAR {
@@ -134,14 +127,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
                 pivot_tolerance: tolerance,
                 ..PartitionParams::default()
             };
-            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) = Partition::compute(
-                sys.mech,
-                &mut sys.ws,
-                t,
-                &sys.q,
-                Preferences::default(),
-                &params,
-            ) {
+            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) =
+                Partition::compute(p.mech, &mut p.ws, t, &p.q, Preferences::default(), &params)
+            {
                 return constraints;
             }
         }
@@ -157,16 +145,16 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             return;
         }
         self.y.copy_from_slice(stepper.y());
-        if self.sys.reconstruct_exact(t, self.y).is_ok() {
+        if self.sys.keep(t, self.y).is_ok() {
             let _ = self.record(t);
         }
     }
 
     fn run(&self, stepper: Option<&Stepper>) -> Run {
         let mut stats = Stats {
-            newton_iterations: self.sys.newton_iterations,
-            factorizations: self.sys.factorizations,
-            repartitions: self.sys.kin.repartitions() as u64,
+            newton_iterations: self.sys.point.newton_iterations,
+            factorizations: self.sys.point.factorizations,
+            repartitions: self.sys.point.kin.repartitions() as u64,
             wall_time: self.started.elapsed(),
             ..Stats::default()
         };
@@ -181,7 +169,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             trajectory: self.traj.clone(),
             stats,
             monitors: self.monitors,
-            redundant_constraints: self.sys.redundant.clone(),
+            redundant_constraints: self.sys.point.redundant.clone(),
             overridden_velocities: self.overridden.clone(),
         }
     }
@@ -214,7 +202,6 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let info = mech.info();
     let n = info.nq();
     let t0 = sim.t0;
-    let form = sim.formulation;
     let empty = |kind| SimError {
         kind,
         partial: Box::new(Run {
@@ -250,9 +237,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             (q, qd)
         }
     };
-    let mut sys = MechSystem::new(
+    let mut sys = System::new(
         mech,
-        form,
+        sim.formulation,
         sim.kinematics,
         sim.dynamics,
         (sim.rtol, sim.atol),
@@ -272,13 +259,23 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         coordinates: &pq,
         velocities: &pqd,
     };
-    let (_, overridden) = sys
-        .kin
-        .assemble_declared(mech, &mut sys.ws, t0, &mut q, &mut qd, &prescription)
-        .map_err(|e| empty(assembly_error(e)))?;
-    sys.q.copy_from_slice(&q);
-    sys.qd.copy_from_slice(&qd);
-    sys.redundant = sys.fit_rows();
+    let overridden = if sim.formulation == Formulation::Unconstrained {
+        // Nothing to enforce, nothing to assemble: the state as given.
+        write_prescription(info, t0, &mut q, &mut qd, &prescription)
+            .map_err(|e| empty(assembly_error(e)))?;
+        Vec::new()
+    } else {
+        let (_, overridden) = sys
+            .point
+            .kin
+            .assemble_declared(mech, &mut sys.point.ws, t0, &mut q, &mut qd, &prescription)
+            .map_err(|e| empty(assembly_error(e)))?;
+        sys.point.invalidate();
+        overridden
+    };
+    sys.point.q.copy_from_slice(&q);
+    sys.point.qd.copy_from_slice(&qd);
+    sys.point.redundant = sys.point.fit_partition();
     if let Err(e) = sys.accept(t0) {
         return Err(empty(e));
     }
@@ -287,7 +284,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         Output::Steps => 1024,
         _ => times.len() + 2,
     };
-    let dim = sys_dim(&sys);
+    let dim = sys.dim();
     let mut y = vec![0.0; dim];
     let mut rec = Recorder {
         sys,
@@ -324,8 +321,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     };
     rec.sys.gather(rec.y);
     if let Err(e) = stepper.reset(&mut rec.sys, t0, rec.y, None) {
-        let c = std::mem::take(&mut rec.sys.failure_constraints);
-        return Err(rec.fail(Some(&stepper), SimErrorKind::from_ode(e, c)));
+        let kind = failure(e, &mut rec.sys);
+        return Err(rec.fail(Some(&stepper), kind));
     }
 
     let mut yout = vec![0.0; dim];
@@ -345,7 +342,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             }
         };
     }
-    let ode = |e: OdeError| SimErrorKind::from_ode(e, Vec::new());
+    let ode = SimErrorKind::from_ode;
 
     while stepper.t() < t_end {
         let attempts = stepper.stats().steps + stepper.stats().rejected;
@@ -358,30 +355,27 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
-                let constraints = std::mem::take(&mut rec.sys.failure_constraints);
-                bail!(SimErrorKind::from_ode(e, constraints));
+                let kind = failure(e, &mut rec.sys);
+                bail!(kind)
             }
         };
+        // The accepted state, corrected as the formulation keeps it (partitioning: the
+        // point of the chart the integrator has just evaluated, polished; the
+        // right-hand side is invariant to the move, so the integrator keeps its
+        // derivatives), then the anchor of the next step.
         rec.y.copy_from_slice(stepper.y());
-        check!(rec.sys.reconstruct_exact(t, rec.y));
-        match form {
-            Formulation::Partitioning => {
-                // The integrated state moved onto the manifold: the right-hand side is
-                // invariant to the move, so the integrator keeps its derivatives. The
-                // state becomes the anchor of the next step's chart.
-                rec.sys.gather(rec.y);
+        let correction = check!(rec.sys.keep(t, rec.y));
+        rec.sys.gather(rec.y);
+        match correction {
+            Correction::None => {}
+            Correction::SameDerivative => {
                 check!(stepper.set_state_keeping_derivative(rec.y).map_err(ode));
-                check!(rec.sys.accept(t));
             }
-            Formulation::Projection => {
-                check!(rec.sys.project(t));
-                rec.sys.gather(rec.y);
-                check!(stepper.set_state(rec.y).map_err(ode));
-            }
-            Formulation::Baumgarte { .. } => {}
+            Correction::Changed => check!(stepper.set_state(rec.y).map_err(ode)),
         }
-        // The accepted state is current: its row (or its monitors), then the rows of
-        // the output times the step passed, which overwrite the full state.
+        check!(rec.sys.accept(t));
+        // Its row (or its monitors), then the rows of the output times the step
+        // passed, which overwrite the full state.
         if steps_mode {
             check!(rec.record(t));
         } else {
@@ -390,10 +384,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         while next_out < times.len() && times[next_out] <= t {
             let to = times[next_out];
             check!(stepper.interpolate(to, &mut yout).map_err(ode));
-            check!(rec.sys.reconstruct_exact(to, &yout));
-            if form == Formulation::Projection {
-                check!(rec.sys.project(to));
-            }
+            check!(rec.sys.keep(to, &yout));
             check!(rec.record(to));
             next_out += 1;
         }
@@ -403,7 +394,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     if rec.traj.t.last() != Some(&t_end) {
         rec.y.copy_from_slice(stepper.y());
-        check!(rec.sys.reconstruct_exact(t_end, rec.y));
+        check!(rec.sys.keep(t_end, rec.y));
         check!(rec.record(t_end));
     }
     Ok(rec.run(Some(&stepper)))
@@ -426,7 +417,12 @@ fn assembly_error(e: AssemblyError) -> SimErrorKind {
     }
 }
 
-fn sys_dim<M: Mechanism + ?Sized>(sys: &MechSystem<'_, M>) -> usize {
-    use crate::ode::OdeSystem;
-    sys.dim()
+/// The kind of an integrator's failure: a failed evaluation's is held by the system.
+fn failure<M: Mechanism + ?Sized>(e: OdeError, sys: &mut System<'_, M>) -> SimErrorKind {
+    match e {
+        OdeError::Rhs { .. } => sys
+            .take_failure()
+            .unwrap_or_else(|| SimErrorKind::from_ode(e)),
+        other => SimErrorKind::from_ode(other),
+    }
 }

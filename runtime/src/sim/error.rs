@@ -29,6 +29,8 @@ pub enum SingularMatrix {
     },
     /// $J J^\mathsf{T}$ (or $C_q C_q^\mathsf{T}$) in a projection.
     Projection,
+    /// The mass matrix (unconstrained formulation: not positive definite).
+    Mass,
 }
 
 impl fmt::Display for SingularMatrix {
@@ -38,6 +40,7 @@ impl fmt::Display for SingularMatrix {
             Self::DependentVelocities => f.write_str("dependent velocity Jacobian `J_d`"),
             Self::Augmented { rank } => write!(f, "augmented matrix (rank of `J` {rank})"),
             Self::Projection => f.write_str("projection matrix `J J^T`"),
+            Self::Mass => f.write_str("mass matrix `M`"),
         }
     }
 }
@@ -270,9 +273,9 @@ impl SimErrorKind {
         }
     }
 
-    /// Classifies an integrator error, unwrapping the analyses' errors from the
-    /// right-hand side.
-    pub(crate) fn from_ode(e: OdeError, constraints: Vec<&'static str>) -> Self {
+    /// Classifies an integrator error (a failed evaluation's own kind is held by the
+    /// system that failed, see `System::take_failure`).
+    pub(crate) fn from_ode(e: OdeError) -> Self {
         match e {
             OdeError::StepSizeTooSmall { t, h } => Self::StepSizeTooSmall { t, h },
             OdeError::MaxStepsExceeded { t, steps } => Self::MaxSteps { t, steps },
@@ -286,19 +289,6 @@ impl SimErrorKind {
                     quantity,
                     component,
                 },
-            },
-            e @ OdeError::Rhs { .. } => match e.into_rhs_error::<Self>() {
-                Ok((_, mut kind)) => {
-                    if let Self::NewtonFailed { constraints: c, .. }
-                    | Self::Singular { constraints: c, .. } = &mut kind
-                    {
-                        if c.is_empty() {
-                            *c = constraints;
-                        }
-                    }
-                    kind
-                }
-                Err(other) => Self::Integrator(other),
             },
             other => Self::Integrator(other),
         }

@@ -47,6 +47,12 @@
 //!   [`Formulation::baumgarte`] gives the defaults $\alpha = \beta = 10\ \text{s}^{-1}$
 //!   (critical damping, time constant 0.1 s; choose them a few times faster than the
 //!   motion of interest and slower than what the step size can resolve).
+//! - [`Formulation::Unconstrained`]: Lagrange's equations of the second kind in all
+//!   coordinates, $M\ddot q = Q$, without multipliers (math-spec (S2-22)): the
+//!   constraints are not enforced. When the applied forces make the motion free
+//!   (math-spec §8) they hold by themselves, and the monitors measure how well. The
+//!   initial state is taken as given (prescriptions are written into it, nothing is
+//!   assembled); $M$ is factored densely.
 //!
 //! # Example
 //! ```
@@ -88,6 +94,8 @@
 mod chart;
 mod driver;
 mod error;
+mod formulation;
+mod point;
 mod precision;
 mod stepper;
 mod system;
@@ -95,6 +103,7 @@ mod trajectory;
 
 pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
+pub use system::{Failed, StateSpace};
 pub use trajectory::{Monitors, Run, Stats, Trajectory};
 
 use crate::{DynamicsParams, KinematicsParams, Mechanism, NewtonParams, PartitionParams};
@@ -140,6 +149,8 @@ pub enum Formulation {
     Partitioning,
     /// Index 1 with projection of positions and velocities after each step.
     Projection,
+    /// $M\ddot q = Q$ in all coordinates, without multipliers (math-spec (S2-22)).
+    Unconstrained,
     /// Index 1 with Baumgarte stabilization.
     Baumgarte {
         /// Velocity-level gain $\alpha$ [1/s].
@@ -159,7 +170,8 @@ impl Formulation {
         }
     }
 
-    /// The three formulations (Baumgarte with its defaults).
+    /// The three formulations that enforce the constraints (Baumgarte with its
+    /// defaults).
     pub const ALL: [Self; 3] = [Self::Partitioning, Self::Projection, Self::baumgarte()];
 
     /// A short name.
@@ -169,6 +181,7 @@ impl Formulation {
             Self::Partitioning => "partitioning",
             Self::Projection => "projection",
             Self::Baumgarte { .. } => "baumgarte",
+            Self::Unconstrained => "unconstrained",
         }
     }
 }

@@ -9,6 +9,10 @@ use super::exact;
 /// Three periods of the pendulum (benchmark-models.md: period 2.36784194757624 s).
 const T_END: f64 = 3.0 * exact::PENDULUM_PERIOD;
 
+/// The error floor of three periods in double precision: about 2000 steps at the
+/// tightest tolerance, each adding a few units of round-off.
+const ROUND_OFF: f64 = 2e-11;
+
 /// Largest error of `x, y, ẋ, ẏ` over the rows against the exact solution.
 fn max_error(run: &Run) -> f64 {
     let tr = &run.trajectory;
@@ -30,8 +34,11 @@ fn max_error(run: &Run) -> f64 {
 /// `t_end·rtol^¼/10`). The largest error over the run, not the final one: at loose
 /// tolerances a final error can be small by a lucky phase.
 ///
-/// Exception: DOPRI5 at rtol 1e-3 takes steps of a sixth of a swing and both
-/// formulations are off by 0.1–1 (measured: partitioning 0.77, projection 0.098).
+/// Exceptions: DOPRI5 at rtol 1e-3 takes steps of a sixth of a swing and both
+/// formulations are off by 0.1–1 (measured: partitioning 0.77, projection 0.098); and
+/// errors below [`ROUND_OFF`], where the run's round-off decides (measured at rtol
+/// 1e-12: partitioning 4e-12 to 2e-11 with the four methods, projection 2e-12 to
+/// 7e-11).
 #[test]
 fn partitioned_error_is_within_three_times_the_projected_one() {
     let model = pendulum::Model::default();
@@ -67,6 +74,9 @@ fn partitioned_error_is_within_three_times_the_projected_one() {
             );
             if method == Method::Dopri5 && k == 3 {
                 assert!(part < 1.0 && proj < 1.0, "{part:e} {proj:e}");
+                continue;
+            }
+            if part <= ROUND_OFF {
                 continue;
             }
             assert!(

@@ -109,6 +109,7 @@ fn every_formulation_and_method_follows_the_exact_solution() {
                     assert_eq!(run.stats.restarts, 0);
                     assert!(m.max_position_violation < 100.0 * rtol);
                 }
+                Formulation::Unconstrained => unreachable!("not in Formulation::ALL"),
             }
         }
     }

@@ -1,0 +1,313 @@
+//! Factorizations for the small dense systems of one evaluation, without the set-up of a
+//! general (blocked, workspace-driven) solver: an $LU$ with partial pivoting and a
+//! Cholesky factorization, row-major, in place, with loops the compiler unrolls and
+//! vectorizes for the sizes of a mechanism (a few to a few dozen unknowns).
+//!
+//! Input: a square matrix written into [`SmallLu::matrix_mut`] or
+//! [`SmallCholesky::matrix_mut`] (row-major, `n × n`). Output: the factors in place
+//! and the pivot magnitudes. Partial pivoting is not rank revealing: callers that must
+//! tell a singular matrix from a regular one (the augmented system with redundant
+//! constraints) check the returned ratio and fall back to complete pivoting
+//! ([`super::dense::DenseLu`]) below their threshold.
+//!
+//! **Equilibration**, as in [`super::dense`]: the $LU$ scales rows, then columns, the
+//! Cholesky factorization rows and columns alike ($D A D$, keeping the symmetry), by
+//! powers of two to a largest magnitude near 1 (a unit diagonal for Cholesky), and the
+//! solves undo it; the pivot ratios are those of the equilibrated matrix, so they do
+//! not depend on the units of the model.
+//!
+//! Invariant: no allocation after construction.
+
+use super::dense::{power_of_two_inverse, Pivots};
+
+/// $PA = LU$ with partial (row) pivoting of an `n × n` matrix.
+#[derive(Clone, Debug)]
+pub(crate) struct SmallLu {
+    n: usize,
+    a: Vec<f64>,
+    perm: Vec<usize>,
+    row_scale: Vec<f64>,
+    col_scale: Vec<f64>,
+}
+
+impl SmallLu {
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            a: vec![0.0; n * n],
+            perm: vec![0; n],
+            row_scale: vec![1.0; n],
+            col_scale: vec![1.0; n],
+        }
+    }
+
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The matrix to factor, row-major; overwritten by the factors.
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.a
+    }
+
+    /// Equilibrates and factors in place; returns the pivot magnitudes ($|u_{kk}|$) of
+    /// the equilibrated matrix.
+    pub fn factor(&mut self) -> Pivots {
+        let n = self.n;
+        let a = &mut self.a;
+        for (row, s) in a.chunks_exact_mut(n.max(1)).zip(&mut self.row_scale) {
+            *s = power_of_two_inverse(row.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+            row.iter_mut().for_each(|x| *x *= *s);
+        }
+        for (j, s) in self.col_scale.iter_mut().enumerate() {
+            let big = (0..n).fold(0.0_f64, |m, i| m.max(a[i * n + j].abs()));
+            *s = power_of_two_inverse(big);
+            for i in 0..n {
+                a[i * n + j] *= *s;
+            }
+        }
+        let (mut max, mut min) = (0.0_f64, f64::INFINITY);
+        for k in 0..n {
+            let mut p = k;
+            let mut best = a[k * n + k].abs();
+            for i in k + 1..n {
+                let v = a[i * n + k].abs();
+                if v > best {
+                    best = v;
+                    p = i;
+                }
+            }
+            self.perm[k] = p;
+            if p != k {
+                for j in 0..n {
+                    a.swap(k * n + j, p * n + j);
+                }
+            }
+            if best.is_nan() {
+                return Pivots { max, min: 0.0 };
+            }
+            max = max.max(best);
+            min = min.min(best);
+            if best == 0.0 {
+                continue;
+            }
+            let inv = 1.0 / a[k * n + k];
+            let (upper, lower) = a.split_at_mut((k + 1) * n);
+            let row_k = &upper[k * n + k + 1..k * n + n];
+            for row in lower.chunks_exact_mut(n) {
+                let l = row[k] * inv;
+                row[k] = l;
+                if l != 0.0 {
+                    for (x, u) in row[k + 1..].iter_mut().zip(row_k) {
+                        *x -= l * u;
+                    }
+                }
+            }
+        }
+        if n == 0 {
+            return Pivots { max: 1.0, min: 1.0 };
+        }
+        Pivots { max, min }
+    }
+
+    /// Solves $A x = b$ in place with the last factorization.
+    pub fn solve(&self, b: &mut [f64]) {
+        let n = self.n;
+        let a = &self.a;
+        // D_r A D_c (D_c⁻¹ x) = D_r b.
+        for (x, s) in b.iter_mut().zip(&self.row_scale) {
+            *x *= s;
+        }
+        for k in 0..n {
+            b.swap(k, self.perm[k]);
+        }
+        for i in 1..n {
+            let s: f64 = a[i * n..i * n + i]
+                .iter()
+                .zip(&b[..i])
+                .map(|(l, x)| l * x)
+                .sum();
+            b[i] -= s;
+        }
+        for i in (0..n).rev() {
+            let s: f64 = a[i * n + i + 1..(i + 1) * n]
+                .iter()
+                .zip(&b[i + 1..])
+                .map(|(u, x)| u * x)
+                .sum();
+            b[i] = (b[i] - s) / a[i * n + i];
+        }
+        for (x, s) in b.iter_mut().zip(&self.col_scale) {
+            *x *= s;
+        }
+    }
+}
+
+/// $A = L L^\mathsf{T}$ of a symmetric positive definite `n × n` matrix (the lower
+/// triangle is read).
+#[derive(Clone, Debug)]
+pub(crate) struct SmallCholesky {
+    n: usize,
+    a: Vec<f64>,
+    scale: Vec<f64>,
+}
+
+impl SmallCholesky {
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            a: vec![0.0; n * n],
+            scale: vec![1.0; n],
+        }
+    }
+
+    /// The matrix to factor, row-major (its lower triangle is used); overwritten by $L$.
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.a
+    }
+
+    /// Factors in place; returns the magnitudes of the pivots of the equivalent $LU$,
+    /// $l_{kk}^2$ (a non-positive pivot, the matrix not positive definite, gives a
+    /// minimum of 0).
+    pub fn factor(&mut self) -> Pivots {
+        let n = self.n;
+        let a = &mut self.a;
+        for (i, s) in self.scale.iter_mut().enumerate() {
+            *s = power_of_two_inverse(a[i * n + i].abs().sqrt());
+        }
+        for i in 0..n {
+            for j in 0..=i {
+                a[i * n + j] *= self.scale[i] * self.scale[j];
+            }
+        }
+        let (mut max, mut min) = (0.0_f64, f64::INFINITY);
+        for j in 0..n {
+            let d = a[j * n + j] - a[j * n..j * n + j].iter().map(|x| x * x).sum::<f64>();
+            if d.is_nan() || d <= 0.0 {
+                return Pivots {
+                    max: max.max(d.abs()),
+                    min: 0.0,
+                };
+            }
+            max = max.max(d);
+            min = min.min(d);
+            let l = d.sqrt();
+            a[j * n + j] = l;
+            let inv = 1.0 / l;
+            for i in j + 1..n {
+                let s: f64 = (0..j).map(|k| a[i * n + k] * a[j * n + k]).sum();
+                a[i * n + j] = (a[i * n + j] - s) * inv;
+            }
+        }
+        if n == 0 {
+            return Pivots { max: 1.0, min: 1.0 };
+        }
+        Pivots { max, min }
+    }
+
+    /// Solves $A x = b$ in place with the last factorization.
+    pub fn solve(&self, b: &mut [f64]) {
+        let n = self.n;
+        let a = &self.a;
+        // D A D (D⁻¹ x) = D b.
+        for (x, s) in b.iter_mut().zip(&self.scale) {
+            *x *= s;
+        }
+        for i in 0..n {
+            let s: f64 = a[i * n..i * n + i]
+                .iter()
+                .zip(&b[..i])
+                .map(|(l, x)| l * x)
+                .sum();
+            b[i] = (b[i] - s) / a[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let s: f64 = (i + 1..n).map(|k| a[k * n + i] * b[k]).sum();
+            b[i] = (b[i] - s) / a[i * n + i];
+        }
+        for (x, s) in b.iter_mut().zip(&self.scale) {
+            *x *= s;
+        }
+    }
+}
+
+/// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
+/// into `ch`, factors it and returns the pivot ratio (0 when not positive definite).
+pub(crate) fn gram_cholesky(ch: &mut SmallCholesky, a: &[f64], rows: &[usize], n: usize) -> f64 {
+    let r = rows.len();
+    let g = ch.matrix_mut();
+    for (i, &ri) in rows.iter().enumerate() {
+        let ri = &a[ri * n..(ri + 1) * n];
+        for (k, &rk) in rows[..=i].iter().enumerate() {
+            let rk = &a[rk * n..(rk + 1) * n];
+            g[i * r + k] = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
+        }
+    }
+    ch.factor().ratio()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fixed well-conditioned matrix and right-hand side (entries from a sine, to
+    /// avoid structure), solved and checked by the residual.
+    #[test]
+    fn lu_and_cholesky_solve_to_round_off() {
+        for n in [1, 2, 3, 7, 13, 30] {
+            let a: Vec<f64> = (0..n * n)
+                .map(|k| {
+                    let (i, j) = (k / n, k % n);
+                    #[allow(clippy::cast_precision_loss)]
+                    let x = ((i * 7 + j * 3) as f64).sin();
+                    x + if i == j { n as f64 } else { 0.0 }
+                })
+                .collect();
+            #[allow(clippy::cast_precision_loss)]
+            let b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+            let residual = |x: &[f64], m: &[f64]| {
+                (0..n)
+                    .map(|i| {
+                        let r: f64 = (0..n).map(|j| m[i * n + j] * x[j]).sum::<f64>() - b[i];
+                        r.abs()
+                    })
+                    .fold(0.0, f64::max)
+            };
+            let mut lu = SmallLu::new(n);
+            lu.matrix_mut().copy_from_slice(&a);
+            assert!(lu.factor().ratio() > 0.0);
+            let mut x = b.clone();
+            lu.solve(&mut x);
+            #[allow(clippy::cast_precision_loss)]
+            let tol = 64.0 * f64::EPSILON * (n * n) as f64;
+            assert!(residual(&x, &a) < tol, "LU n = {n}");
+            // AᵀA + I is symmetric positive definite.
+            let s: Vec<f64> = (0..n * n)
+                .map(|k| {
+                    let (i, j) = (k / n, k % n);
+                    (0..n).map(|r| a[r * n + i] * a[r * n + j]).sum::<f64>()
+                        + if i == j { 1.0 } else { 0.0 }
+                })
+                .collect();
+            let mut ch = SmallCholesky::new(n);
+            ch.matrix_mut().copy_from_slice(&s);
+            assert!(ch.factor().ratio() > 0.0);
+            let mut x = b.clone();
+            ch.solve(&mut x);
+            assert!(
+                residual(&x, &s) < tol * n as f64 * n as f64,
+                "Cholesky n = {n}"
+            );
+        }
+    }
+
+    #[test]
+    fn singular_and_indefinite_matrices_are_reported() {
+        let mut lu = SmallLu::new(2);
+        lu.matrix_mut().copy_from_slice(&[1.0, 2.0, 2.0, 4.0]);
+        assert_eq!(lu.factor().ratio(), 0.0);
+        let mut ch = SmallCholesky::new(2);
+        ch.matrix_mut().copy_from_slice(&[1.0, 2.0, 2.0, 1.0]);
+        assert_eq!(ch.factor().ratio(), 0.0);
+    }
+}

@@ -1,0 +1,483 @@
+//! The formulations of [`Formulation`]: one implementation of [`Form`] each, on the
+//! shared [`Point`].
+//!
+//! Input: the integrator's state $y = [q; \dot q]$ and the current [`Point`]. Output: the
+//! full state the formulation assigns to $y$ ([`Form::reconstruct`]), $\ddot q$
+//! ([`Form::accelerations`]), the corrections of kept states ([`Form::keep`]) and what
+//! the integrator must do with them ([`Form::CORRECTION`]), and which failures of the
+//! right-hand side only reject a step attempt ([`Form::recoverable`]).
+//!
+//! | formulation | reconstruct | kept states | failures that reject an attempt |
+//! |---|---|---|---|
+//! | [`Partitioned`] | the point of the chart of the last accepted state | polished to the Newton tolerance; the derivative stays valid | the chart's Newton, a singular projection |
+//! | [`Projected`] | $y$ as it is | projected on $C = 0$, $J\dot q + c = 0$ | none |
+//! | [`Stabilized`] | $y$ as it is | as they are | none |
+//! | [`Free`] | $y$ as it is | as they are | none |
+
+use super::chart::{Chart, ChartFailure};
+use super::error::{SimErrorKind, SingularMatrix};
+use super::point::{Point, REFIT_RATIO, SINGULAR_RATIO};
+use super::Formulation;
+use crate::linalg::inf_norm;
+use crate::Mechanism;
+
+/// Relative size of a Newton correction of the integrator's prediction that never
+/// counts as a branch switch (see [`Partitioned`]), for the evaluations that hardly
+/// move (a correction within the integrator's tolerance never counts either).
+const BRANCH_FLOOR: f64 = 1e-8;
+
+/// Fraction of its value when the rows were chosen below which the pivot ratio of the
+/// chart's $N N^\mathsf{T}$ renews the kept rows of a model with redundant constraints:
+/// the kept rows are turning dependent while the dropped ones could take over.
+const REFIT_FRACTION: f64 = 1e-2;
+
+/// What the driver does with a kept state after [`Form::keep`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Correction {
+    /// Nothing changed.
+    None,
+    /// The state changed, its derivative did not: the integrator keeps its derivatives.
+    SameDerivative,
+    /// The state and its derivative changed.
+    Changed,
+}
+
+/// One way of turning the constrained equations into an ODE on $y = [q; \dot q]$.
+pub(crate) trait Form {
+    /// What [`keep`](Self::keep) does to an accepted state, for the integrator.
+    const CORRECTION: Correction;
+
+    /// Takes the current full state of `p` (consistent, at `t`) as the last accepted
+    /// one.
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind>;
+
+    /// Fills `p.q`, `p.qd` from the state `y` at `t`.
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind>;
+
+    /// $\ddot q$ and $\lambda$ at the full state of `p`.
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind>;
+
+    /// Corrects a state the driver keeps (accepted or output), already reconstructed.
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind>;
+
+    /// Whether a failure of the right-hand side only rejects the step attempt.
+    fn recoverable(&self, e: &SimErrorKind) -> bool;
+}
+
+/// Copies $y = [q; \dot q]$ into the state of `p`.
+fn copy_state<M: Mechanism + ?Sized>(p: &mut Point<'_, M>, y: &[f64]) {
+    let n = p.q.len();
+    p.q.copy_from_slice(&y[..n]);
+    p.qd.copy_from_slice(&y[n..]);
+}
+
+/// Coordinate partitioning in the local chart of the last accepted state
+/// ([`Formulation::Partitioning`], see [`Chart`]).
+///
+/// The chart's Newton converges to the intersection of the normal space through the
+/// prediction with the manifold nearest to it; a correction larger than the move from
+/// the last accepted state means it went to another one (the mirror assembly of a
+/// loop), so the evaluation fails, recoverably.
+#[derive(Debug)]
+pub(crate) struct Partitioned {
+    chart: Chart,
+    /// The last accepted positions.
+    accepted: Vec<f64>,
+    /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
+    /// before the first anchor): the reference of [`REFIT_FRACTION`].
+    fit_ratio: f64,
+    /// The `(t, y)` whose state is in the point (the last reconstruction), so that the
+    /// driver's reconstruction of an accepted state the integrator has just evaluated
+    /// costs nothing.
+    cached: Option<f64>,
+    y_cached: Vec<f64>,
+}
+
+impl Partitioned {
+    pub fn new(n: usize, m: usize, mh: usize, (rtol, atol): (f64, f64)) -> Self {
+        Self {
+            chart: Chart::new(n, m, mh, rtol, atol),
+            accepted: vec![0.0; n],
+            fit_ratio: 0.0,
+            cached: None,
+            y_cached: vec![0.0; 2 * n],
+        }
+    }
+}
+
+impl Form for Partitioned {
+    const CORRECTION: Correction = Correction::SameDerivative;
+
+    /// Anchors the chart of the next step at the accepted state.
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        self.accepted.copy_from_slice(&p.q);
+        if p.rows_h == 0 {
+            return Ok(());
+        }
+        p.factorizations += 1;
+        let eval = SimErrorKind::from_eval;
+        let mut ratio = self.chart.anchor(p, t).map_err(eval)?;
+        let worse =
+            ratio.is_nan() || ratio <= REFIT_RATIO || ratio < REFIT_FRACTION * self.fit_ratio;
+        if worse && p.refit(t) {
+            ratio = self.chart.anchor(p, t).map_err(eval)?;
+            self.fit_ratio = ratio;
+        }
+        if self.fit_ratio == 0.0 {
+            self.fit_ratio = ratio;
+        }
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Projection,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The point of the chart: Newton on the normal coordinates from `y`, then the
+    /// orthogonal projection of the velocities.
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        if self.cached == Some(t) && self.y_cached == y {
+            return Ok(());
+        }
+        self.cached = None;
+        copy_state(p, y);
+        if p.rows_h > 0 {
+            match self.chart.correct(p, t) {
+                Ok(iterations) => p.newton_iterations += iterations as u64,
+                Err(ChartFailure::Eval(e)) => return Err(SimErrorKind::from_eval(e)),
+                Err(ChartFailure::Newton {
+                    iterations,
+                    residual,
+                }) => {
+                    p.newton_iterations += iterations as u64;
+                    let tol = p.newton.tolerance;
+                    return Err(SimErrorKind::NewtonFailed {
+                        t,
+                        iterations,
+                        residual,
+                        constraints: p.violated(t, tol),
+                    });
+                }
+            }
+            let (mut moved, mut correction) = (0.0_f64, 0.0_f64);
+            for ((&yj, &qj), &aj) in y.iter().zip(&p.q).zip(&self.accepted) {
+                moved = moved.max((yj - aj).abs());
+                correction = correction.max((qj - yj).abs());
+            }
+            let scale = inf_norm(&p.q);
+            let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
+            if correction > moved + floor {
+                return Err(SimErrorKind::NewtonFailed {
+                    t,
+                    iterations: 0,
+                    residual: correction,
+                    constraints: Vec::new(),
+                });
+            }
+        }
+        p.project_velocities(t)?;
+        self.cached = Some(t);
+        self.y_cached.copy_from_slice(y);
+        Ok(())
+    }
+
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.accelerations(t, None)
+    }
+
+    /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
+    /// Newton, then the velocities): below the integrator's tolerance, so the
+    /// derivatives the integrator keeps stay valid.
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        self.cached = None;
+        p.project(t)
+    }
+
+    fn recoverable(&self, e: &SimErrorKind) -> bool {
+        matches!(
+            e,
+            SimErrorKind::NewtonFailed { .. } | SimErrorKind::Singular { .. }
+        )
+    }
+}
+
+/// Index 1 with projection of positions and velocities after each step
+/// ([`Formulation::Projection`]).
+#[derive(Debug)]
+pub(crate) struct Projected;
+
+impl Form for Projected {
+    const CORRECTION: Correction = Correction::Changed;
+
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        _: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        copy_state(p, y);
+        Ok(())
+    }
+
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.accelerations(t, None)
+    }
+
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.project(t)
+    }
+
+    fn recoverable(&self, _: &SimErrorKind) -> bool {
+        false
+    }
+}
+
+/// Index 1 with Baumgarte stabilization ([`Formulation::Baumgarte`]).
+#[derive(Debug)]
+pub(crate) struct Stabilized {
+    alpha: f64,
+    beta: f64,
+    shift: Vec<f64>,
+}
+
+impl Stabilized {
+    pub fn new(alpha: f64, beta: f64, m: usize) -> Self {
+        Self {
+            alpha,
+            beta,
+            shift: vec![0.0; m],
+        }
+    }
+}
+
+impl Form for Stabilized {
+    const CORRECTION: Correction = Correction::None;
+
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        _: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        copy_state(p, y);
+        Ok(())
+    }
+
+    /// With $\gamma$ shifted by $-2\alpha[C_q\dot q + C_t; G\dot q + g] - \beta^2[C; 0]$.
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.baumgarte_shift(t, self.alpha, self.beta, &mut self.shift)
+            .map_err(SimErrorKind::from_eval)?;
+        p.accelerations(t, Some(&self.shift))
+    }
+
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn recoverable(&self, _: &SimErrorKind) -> bool {
+        false
+    }
+}
+
+/// $M\ddot q = Q$ without multipliers ([`Formulation::Unconstrained`]).
+#[derive(Debug)]
+pub(crate) struct Free;
+
+impl Form for Free {
+    const CORRECTION: Correction = Correction::None;
+
+    fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        _: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        copy_state(p, y);
+        Ok(())
+    }
+
+    fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        p.free_accelerations(t)
+    }
+
+    fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        _: &mut Point<'_, M>,
+        _: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
+
+    fn recoverable(&self, _: &SimErrorKind) -> bool {
+        false
+    }
+}
+
+/// The formulation chosen at run time.
+// One lives per run, so the size of the largest variant (the chart's scratch) costs
+// nothing worth a box.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub(crate) enum AnyForm {
+    Partitioned(Partitioned),
+    Projected(Projected),
+    Stabilized(Stabilized),
+    Free(Free),
+}
+
+impl AnyForm {
+    /// The implementation of `formulation` for a model with `n` coordinates, `m`
+    /// constraint rows of which `mh` holonomic, and the integrator's tolerances.
+    pub fn new(formulation: Formulation, n: usize, m: usize, mh: usize, tol: (f64, f64)) -> Self {
+        match formulation {
+            Formulation::Partitioning => Self::Partitioned(Partitioned::new(n, m, mh, tol)),
+            Formulation::Projection => Self::Projected(Projected),
+            Formulation::Baumgarte { alpha, beta } => {
+                Self::Stabilized(Stabilized::new(alpha, beta, m))
+            }
+            Formulation::Unconstrained => Self::Free(Free),
+        }
+    }
+
+    /// What [`keep`](Form::keep) does to an accepted state.
+    pub fn correction(&self) -> Correction {
+        match self {
+            Self::Partitioned(_) => Partitioned::CORRECTION,
+            Self::Projected(_) => Projected::CORRECTION,
+            Self::Stabilized(_) => Stabilized::CORRECTION,
+            Self::Free(_) => Free::CORRECTION,
+        }
+    }
+}
+
+macro_rules! each {
+    ($self:expr, $f:ident => $body:expr) => {
+        match $self {
+            AnyForm::Partitioned($f) => $body,
+            AnyForm::Projected($f) => $body,
+            AnyForm::Stabilized($f) => $body,
+            AnyForm::Free($f) => $body,
+        }
+    };
+}
+
+impl AnyForm {
+    pub fn accept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.accept(p, t))
+    }
+
+    pub fn reconstruct<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.reconstruct(p, t, y))
+    }
+
+    pub fn accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.accelerations(p, t))
+    }
+
+    pub fn keep<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.keep(p, t))
+    }
+
+    pub fn recoverable(&self, e: &SimErrorKind) -> bool {
+        each!(self, f => f.recoverable(e))
+    }
+}

@@ -1,0 +1,509 @@
+//! The full state at one point $(t, q, \dot q)$ and what is evaluated there, shared by
+//! the formulations ([`super::formulation`]).
+//!
+//! Input: a model and its analysis scratch. Output: $C$, $J$, $[C_t; g]$, the velocity
+//! residuals, the projections onto the constraints, $\ddot q$ and $\lambda$ at the
+//! current state.
+//!
+//! Invariant: a quantity is evaluated at most once per point. Each group of generated
+//! functions is stamped with the $(t, q)$ (and $\dot q$ for the dynamics terms) it was
+//! evaluated at and reused while the state is unchanged (bitwise), so the velocity
+//! projection, the augmented solve, the monitors and the record of one state share one
+//! $C_q$; the stamps compare $n$ numbers, which costs far less than any evaluation.
+//! Nothing allocates after [`Point::new`] (except when building an error).
+
+use super::error::{SimErrorKind, SingularMatrix};
+use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
+use crate::kinematics::{Kinematics, KinematicsParams};
+use crate::linalg::inf_norm;
+use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::scale;
+use crate::workspace::{EvalError, Workspace};
+use crate::{Error, Info, Mechanism, NewtonParams};
+
+/// Pivot ratio below which a projection matrix $J J^\mathsf{T}$ counts as singular.
+pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
+
+/// Pivot ratio of a projection matrix (equilibrated $J_R J_R^\mathsf{T}$) below which
+/// the kept rows of a model with redundant constraints are renewed (see
+/// [`Point::refit`]): a ratio of $10^{-8}$ is a condition of $10^4$ for $J_R$, where
+/// Newton starts to stall long before the matrix is singular.
+pub(crate) const REFIT_RATIO: f64 = 1e-8;
+
+/// The point a group of evaluations was made at.
+#[derive(Debug)]
+struct Stamp {
+    valid: bool,
+    t: f64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+}
+
+impl Stamp {
+    fn new(n: usize, velocities: bool) -> Self {
+        Self {
+            valid: false,
+            t: 0.0,
+            q: vec![0.0; n],
+            qd: vec![0.0; if velocities { n } else { 0 }],
+        }
+    }
+
+    /// Whether the group holds values at `(t, q, qd)` (`qd` ignored for position-only
+    /// groups).
+    fn matches(&self, t: f64, q: &[f64], qd: &[f64]) -> bool {
+        self.valid
+            && self.t.to_bits() == t.to_bits()
+            && self.q == q
+            && (self.qd.is_empty() || self.qd == qd)
+    }
+
+    /// Records that the group now holds values at `(t, q, qd)`.
+    fn set(&mut self, t: f64, q: &[f64], qd: &[f64]) {
+        self.valid = true;
+        self.t = t;
+        self.q.copy_from_slice(q);
+        if !self.qd.is_empty() {
+            self.qd.copy_from_slice(qd);
+        }
+    }
+
+    /// [`matches`](Self::matches); otherwise invalidates the stamp, for the caller to
+    /// evaluate and [`set`](Self::set) it.
+    fn check(&mut self, t: f64, q: &[f64], qd: &[f64]) -> bool {
+        let same = self.matches(t, q, qd);
+        self.valid &= same;
+        same
+    }
+}
+
+/// The current full state and the evaluations made at it.
+pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
+    pub mech: &'a M,
+    pub info: &'static Info,
+    pub ws: Workspace,
+    pub dynamics: Dynamics,
+    /// Assembly, Algorithm P and the choice of the independent constraint rows.
+    pub kin: Kinematics,
+    /// Newton tolerance of the position projection.
+    pub newton: NewtonParams,
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub lambda: Vec<f64>,
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$.
+    vel: Vec<f64>,
+    mu: Vec<f64>,
+    lu_h: SmallCholesky,
+    lu_v: SmallCholesky,
+    /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
+    mass: SmallCholesky,
+    /// The constraint rows projected on, the first `rows_h` holonomic (all rows unless
+    /// assembly dropped redundant ones, see [`Point::fit_rows`]).
+    pub rows: Vec<usize>,
+    pub rows_h: usize,
+    /// $C$; the pattern values of $C_q$, $G$ (written by their own functions or by the
+    /// dynamics terms); the dense $J$; $C_t$, $g$; the dynamics terms ($M$, $Q$,
+    /// $\gamma$); $\ddot q$, $\lambda$ (solved with the formulation's shift, a function
+    /// of the state).
+    constraints: Stamp,
+    jacobian: Stamp,
+    dense: Stamp,
+    rates: Stamp,
+    terms: Stamp,
+    solved: Stamp,
+    pub newton_iterations: u64,
+    pub factorizations: u64,
+    /// Constraints the augmented solve found redundant so far.
+    pub redundant: Vec<&'static str>,
+}
+
+impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
+    pub fn new(
+        mech: &'a M,
+        dynamics: DynamicsParams,
+        kin: KinematicsParams,
+    ) -> Result<Self, Error> {
+        let info = mech.info();
+        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        Ok(Self {
+            mech,
+            info,
+            ws: Workspace::new(info)?,
+            dynamics: Dynamics::new(info, dynamics)?,
+            kin: Kinematics::new(info, kin),
+            newton: kin.newton,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            lambda: vec![0.0; m],
+            vel: vec![0.0; m],
+            mu: vec![0.0; m],
+            lu_h: SmallCholesky::new(mh),
+            lu_v: SmallCholesky::new(m),
+            mass: SmallCholesky::new(0),
+            rows: (0..m).collect(),
+            rows_h: mh,
+            constraints: Stamp::new(n, false),
+            jacobian: Stamp::new(n, false),
+            dense: Stamp::new(n, false),
+            rates: Stamp::new(n, false),
+            terms: Stamp::new(n, true),
+            solved: Stamp::new(n, true),
+            newton_iterations: 0,
+            factorizations: 0,
+            redundant: Vec::new(),
+        })
+    }
+
+    /// Forgets every evaluation (after the workspace was used directly, as assembly
+    /// does).
+    pub fn invalidate(&mut self) {
+        for s in [
+            &mut self.constraints,
+            &mut self.jacobian,
+            &mut self.dense,
+            &mut self.rates,
+            &mut self.terms,
+            &mut self.solved,
+        ] {
+            s.valid = false;
+        }
+    }
+
+    /// Keeps only the independent holonomic rows `holonomic` (and every non-holonomic
+    /// one) in the projections, after assembly dropped redundant constraints
+    /// (allocates).
+    pub fn fit_rows(&mut self, holonomic: &[usize]) {
+        let (mh, nnh) = (self.info.nh(), self.info.nnh());
+        self.rows.clear();
+        self.rows.extend_from_slice(holonomic);
+        self.rows.extend(mh..mh + nnh);
+        self.rows_h = holonomic.len();
+        if self.rows_h != mh {
+            self.lu_h = SmallCholesky::new(self.rows_h);
+            self.lu_v = SmallCholesky::new(self.rows.len());
+        }
+    }
+
+    /// Fits the projections to the current partition, which may have dropped redundant
+    /// holonomic constraints; returns the names of the dropped ones.
+    pub fn fit_partition(&mut self) -> Vec<&'static str> {
+        let Some(p) = self.kin.partition() else {
+            return Vec::new();
+        };
+        let info = self.info;
+        let names = p
+            .redundant_rows()
+            .iter()
+            .map(|&i| info.holonomic[i].name)
+            .collect();
+        let rows = p.holonomic_rows().to_vec();
+        self.fit_rows(&rows);
+        names
+    }
+
+    /// Renews the redundant holonomic rows left out of the projections and the chart,
+    /// when there are any: which rows of a dependent set are independent changes along
+    /// the motion (the three pin_y rows of the parallelogram become dependent at the
+    /// bottom of its swing, and a set that dropped a pin_x row turns singular there).
+    /// Returns whether the rows were renewed (the rank of $C_q$ unchanged).
+    pub fn refit(&mut self, t: f64) -> bool {
+        let redundant = self
+            .kin
+            .partition()
+            .is_some_and(|p| !p.redundant_rows().is_empty());
+        if !redundant {
+            return false;
+        }
+        let rank = self.rows_h;
+        let ok = self
+            .kin
+            .repartition(self.mech, &mut self.ws, t, &self.q)
+            .is_ok_and(|p| p.holonomic_rows().len() == rank);
+        // Algorithm P evaluated J into the workspace itself.
+        self.invalidate();
+        if ok {
+            self.fit_partition();
+        }
+        ok
+    }
+
+    /// $C$ at the current $(t, q)$.
+    pub fn constraints(&mut self, t: f64) -> Result<&[f64], EvalError> {
+        if !self.constraints.check(t, &self.q, &[]) {
+            self.ws.eval_constraints(self.mech, t, &self.q)?;
+            self.constraints.set(t, &self.q, &[]);
+        }
+        Ok(self.ws.constraints())
+    }
+
+    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$.
+    fn jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
+        if !self.jacobian.check(t, &self.q, &[]) {
+            self.ws.eval_jacobian_values(self.mech, t, &self.q)?;
+            self.jacobian.set(t, &self.q, &[]);
+        }
+        Ok(())
+    }
+
+    /// The dense $J$ at the current $(t, q)$.
+    pub fn dense_jacobian(&mut self, t: f64) -> Result<&[f64], EvalError> {
+        if !self.dense.check(t, &self.q, &[]) {
+            self.jacobian_values(t)?;
+            self.ws.scatter_jacobian();
+            self.dense.set(t, &self.q, &[]);
+        }
+        Ok(self.ws.jacobian())
+    }
+
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel`.
+    fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
+        let info = self.info;
+        let mh = info.nh();
+        self.jacobian_values(t)?;
+        if !self.rates.check(t, &self.q, &[]) {
+            self.ws.eval_rates(self.mech, t, &self.q)?;
+            self.rates.set(t, &self.q, &[]);
+        }
+        self.vel[..mh].copy_from_slice(&self.ws.ct);
+        self.vel[mh..].copy_from_slice(&self.ws.bias);
+        for (&(r, c), v) in info.holonomic_pattern.iter().zip(&self.ws.cq_values) {
+            self.vel[r as usize] += v * self.qd[c as usize];
+        }
+        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(&self.ws.g_values) {
+            self.vel[mh + r as usize] += v * self.qd[c as usize];
+        }
+        Ok(())
+    }
+
+    /// $(\lVert C\rVert_\infty, \lVert C_q\dot q + C_t\rVert_\infty,
+    /// \lVert G\dot q + g\rVert_\infty)$ at the current state.
+    pub fn violations(&mut self, t: f64) -> Result<(f64, f64, f64), EvalError> {
+        let c = inf_norm(self.constraints(t)?);
+        self.velocity_residuals(t)?;
+        let mh = self.info.nh();
+        Ok((c, inf_norm(&self.vel[..mh]), inf_norm(&self.vel[mh..])))
+    }
+
+    /// $\ddot q$ and $\lambda$ at the current state from (E31), with $\gamma$ replaced
+    /// by $\gamma + s$ when `shift` gives $s$ (Baumgarte); the terms come from one call
+    /// of the model's fused evaluation.
+    pub fn accelerations(&mut self, t: f64, shift: Option<&[f64]>) -> Result<(), SimErrorKind> {
+        // A shift depends on the state only, so (t, q, q̇) identifies the solution.
+        if self.solved.check(t, &self.q, &self.qd) {
+            return Ok(());
+        }
+        if !self.terms.check(t, &self.q, &self.qd) {
+            // The fused evaluation writes C_q and G at (t, q) too.
+            self.jacobian.valid = false;
+            self.ws
+                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
+                .map_err(SimErrorKind::from_eval)?;
+            self.terms.set(t, &self.q, &self.qd);
+            self.jacobian.set(t, &self.q, &[]);
+        }
+        self.factorizations += 1;
+        let stats = self
+            .dynamics
+            .solve_evaluated(&mut self.ws, t, shift, &mut self.qdd, &mut self.lambda)
+            .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
+        if stats.path == SolverPath::Redundant {
+            // The redundant path scattered J at this point into the dense array.
+            self.dense.set(t, &self.q, &[]);
+        }
+        self.solved.set(t, &self.q, &self.qd);
+        // Reported once, as first identified: which rows of a dependent set the
+        // pivoting names can change along the motion, the redundancy does not.
+        if self.redundant.is_empty() {
+            self.redundant.extend(self.dynamics.redundant_constraints());
+        }
+        Ok(())
+    }
+
+    /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
+    /// $\lambda = 0$.
+    pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if self.solved.check(t, &self.q, &self.qd) {
+            return Ok(());
+        }
+        if !self.terms.check(t, &self.q, &self.qd) {
+            self.jacobian.valid = false;
+            self.ws
+                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
+                .map_err(SimErrorKind::from_eval)?;
+            self.terms.set(t, &self.q, &self.qd);
+            self.jacobian.set(t, &self.q, &[]);
+        }
+        let info = self.info;
+        let n = info.nq();
+        if self.mass.matrix_mut().len() != n * n {
+            self.mass = SmallCholesky::new(n);
+        }
+        let a = self.mass.matrix_mut();
+        a.fill(0.0);
+        for (&(r, c), &v) in info.mass_pattern.iter().zip(&self.ws.mass_values) {
+            a[r as usize * n + c as usize] = v;
+        }
+        self.factorizations += 1;
+        let ratio = self.mass.factor().ratio();
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Mass,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
+        self.qdd.copy_from_slice(&self.ws.forces);
+        self.mass.solve(&mut self.qdd);
+        self.lambda.fill(0.0);
+        self.solved.set(t, &self.q, &self.qd);
+        Ok(())
+    }
+
+    /// The Baumgarte shift $s = -2\alpha [C_q\dot q + C_t; G\dot q + g] - \beta^2 [C; 0]$
+    /// at the current state, into `shift`.
+    pub fn baumgarte_shift(
+        &mut self,
+        t: f64,
+        alpha: f64,
+        beta: f64,
+        shift: &mut [f64],
+    ) -> Result<(), EvalError> {
+        let mh = self.info.nh();
+        self.constraints(t)?;
+        self.velocity_residuals(t)?;
+        let c = self.ws.constraints();
+        for (i, s) in shift.iter_mut().enumerate() {
+            let position = if i < mh { beta * beta * c[i] } else { 0.0 };
+            *s = -2.0 * alpha * self.vel[i] - position;
+        }
+        Ok(())
+    }
+
+    /// Projection onto the constraint manifold: Newton with minimum-norm corrections
+    /// $\Delta q = -C_q^\mathsf{T}(C_q C_q^\mathsf{T})^{-1}C$ on the positions until
+    /// $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$, then
+    /// [`project_velocities`](Self::project_velocities).
+    pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let n = self.info.nq();
+        let eval = SimErrorKind::from_eval;
+        let tol = self.newton.tolerance;
+        // One renewal of the dropped redundant rows per projection (see `refit`).
+        let mut refitted = false;
+        if self.rows_h > 0 {
+            let mut iterations = 0;
+            loop {
+                let residual = inf_norm(self.constraints(t).map_err(eval)?);
+                self.dense_jacobian(t).map_err(eval)?;
+                let size = scale::coordinate_size(&self.q);
+                if scale::all_met(self.ws.constraints(), self.ws.jacobian(), n, tol, size) {
+                    break;
+                }
+                let stalled = iterations == self.newton.max_iterations || !residual.is_finite();
+                if stalled && !refitted && self.refit(t) {
+                    (refitted, iterations) = (true, 0);
+                    continue;
+                }
+                if stalled {
+                    return Err(SimErrorKind::NewtonFailed {
+                        t,
+                        iterations,
+                        residual,
+                        constraints: self.violated(t, tol),
+                    });
+                }
+                let rows = &self.rows[..self.rows_h];
+                let ratio = gram_cholesky(&mut self.lu_h, self.ws.jacobian(), rows, n);
+                if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
+                    refitted = true;
+                    continue;
+                }
+                if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+                    return Err(SimErrorKind::Singular {
+                        t,
+                        matrix: SingularMatrix::Projection,
+                        ratio,
+                        constraints: self.violated(t, tol),
+                    });
+                }
+                let rows = &self.rows[..self.rows_h];
+                for (mu, &i) in self.mu.iter_mut().zip(rows) {
+                    *mu = self.ws.constraints()[i];
+                }
+                self.lu_h.solve(&mut self.mu[..rows.len()]);
+                let jac = self.ws.jacobian();
+                for (&i, mu) in rows.iter().zip(&self.mu) {
+                    for (qj, a) in self.q.iter_mut().zip(&jac[i * n..(i + 1) * n]) {
+                        *qj -= a * mu;
+                    }
+                }
+                iterations += 1;
+                self.newton_iterations += 1;
+                self.factorizations += 1;
+            }
+        }
+        self.project_velocities(t)
+    }
+
+    /// The orthogonal projection of the velocities onto the velocity constraints at the
+    /// current positions,
+    /// $\dot q \leftarrow \dot q - J^\mathsf{T}(J J^\mathsf{T})^{-1}(J\dot q + [C_t; g])$
+    /// (the rows `rows`).
+    pub fn project_velocities(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let n = self.info.nq();
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        let eval = SimErrorKind::from_eval;
+        self.velocity_residuals(t).map_err(eval)?;
+        self.dense_jacobian(t).map_err(eval)?;
+        let mut ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        if (ratio.is_nan() || ratio <= REFIT_RATIO) && self.refit(t) {
+            self.velocity_residuals(t).map_err(eval)?;
+            self.dense_jacobian(t).map_err(eval)?;
+            ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        }
+        let rows = &self.rows[..];
+        self.factorizations += 1;
+        if ratio.is_nan() || ratio <= SINGULAR_RATIO {
+            return Err(SimErrorKind::Singular {
+                t,
+                matrix: SingularMatrix::Projection,
+                ratio,
+                constraints: Vec::new(),
+            });
+        }
+        for (mu, &i) in self.mu.iter_mut().zip(rows) {
+            *mu = self.vel[i];
+        }
+        self.lu_v.solve(&mut self.mu[..rows.len()]);
+        let jac = self.ws.jacobian();
+        for (&i, mu) in rows.iter().zip(&self.mu) {
+            for (v, a) in self.qd.iter_mut().zip(&jac[i * n..(i + 1) * n]) {
+                *v -= a * mu;
+            }
+        }
+        Ok(())
+    }
+
+    /// The holonomic constraints not met to the relative `tolerance` at the current
+    /// $(t, q)$ (see [`crate::scale`]); empty when they cannot be evaluated.
+    pub fn violated(&mut self, t: f64, tolerance: f64) -> Vec<&'static str> {
+        if self.constraints(t).is_err() || self.dense_jacobian(t).is_err() {
+            return Vec::new();
+        }
+        let size = scale::coordinate_size(&self.q);
+        let n = self.info.nq();
+        scale::unmet(
+            self.ws.constraints(),
+            self.ws.jacobian(),
+            n,
+            tolerance,
+            size,
+        )
+        .map(|i| self.info.holonomic[i].name)
+        .collect()
+    }
+}

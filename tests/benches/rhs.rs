@@ -1,0 +1,122 @@
+//! One right-hand side of each formulation next to the generated functions it calls,
+//! in one run, per model:
+//!
+//! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C_q$,
+//!   $\gamma$, $G$), of `holonomic` ($C$) and of `holonomic_jacobian` ($C_q$): what
+//!   every formulation evaluates at least once per point;
+//! - `partitioning`, `projection`, `baumgarte`: one `rhs` of [`StateSpace`] at a moving
+//!   state off the constraint manifold by a predictor's error (an Euler step of 1e-3
+//!   of the motion's time scale from a consistent state), alternating between two such
+//!   states so that nothing is reused from the previous call; partitioning does its
+//!   usual Newton update there.
+//!
+//! Models: `pendulum` and `andrews`. Another model is one entry of [`CASES`] (the
+//! 100-body chain of the body-level generator is the next one).
+//!
+//! `cargo bench -p pfaff-tests --bench rhs [-- andrews]`
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use pfaff::ode::OdeSystem;
+use pfaff::sim::{Formulation, Method, Simulation, StateSpace};
+use pfaff::{DynamicsTerms, Mechanism};
+
+/// A model, and the time after which its state is moving (taken by a tight run from
+/// its initial state) and its motion's time scale.
+type Case = (&'static str, fn() -> Box<dyn Mechanism>, f64, f64);
+
+const CASES: &[Case] = &[
+    (
+        "pendulum",
+        || Box::new(pfaff_models::pendulum::Model::default()),
+        0.3,
+        0.3,
+    ),
+    (
+        "andrews",
+        || Box::new(pfaff_models::andrews::Model::default()),
+        0.01,
+        1e-3,
+    ),
+];
+
+/// The consistent state at `t` from the model's initial state.
+fn moving_state(model: &dyn Mechanism, t: f64) -> (Vec<f64>, Vec<f64>) {
+    let run = Simulation::new(model)
+        .integrator(Method::Dop853)
+        .tolerances(1e-12, 1e-14)
+        .output_times(&[])
+        .run(t)
+        .expect("the reference run");
+    let (_, q, qd) = run.final_state().expect("a final row");
+    (q.to_vec(), qd.to_vec())
+}
+
+fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut forces = vec![0.0; n];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut gamma = vec![0.0; mh + mnh];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut constraints = vec![0.0; mh];
+    let mut jacobian = vec![0.0; info.holonomic_pattern.len()];
+    c.bench_function(&format!("{name}/generated"), |b| {
+        b.iter(|| {
+            let (gh, gnh) = gamma.split_at_mut(mh);
+            model.dynamics_terms(
+                black_box(t),
+                black_box(q),
+                black_box(qd),
+                DynamicsTerms {
+                    mass: &mut mass,
+                    forces: &mut forces,
+                    holonomic_jacobian: &mut cq,
+                    holonomic_gamma: gh,
+                    nonholonomic_matrix: &mut g,
+                    nonholonomic_gamma: gnh,
+                },
+            );
+            model.holonomic(black_box(t), black_box(q), &mut constraints);
+            model.holonomic_jacobian(black_box(t), black_box(q), &mut jacobian);
+            black_box((&mass, &forces, &constraints, &jacobian));
+        });
+    });
+}
+
+fn rhs(c: &mut Criterion) {
+    for &(name, make, t, scale) in CASES {
+        let model = make();
+        let (q, qd) = moving_state(model.as_ref(), t);
+        generated(c, name, model.as_ref(), t, &q, &qd);
+        let n = q.len();
+        for form in Formulation::ALL {
+            let mut sys = StateSpace::new(model.as_ref(), form, 1e-8, 1e-8).expect("patterns");
+            sys.start(t, &q, &qd).expect("a consistent state");
+            let mut y0 = q.clone();
+            y0.extend_from_slice(&qd);
+            let mut f = vec![0.0; 2 * n];
+            sys.rhs(t, &y0, &mut f).expect("an evaluation at the start");
+            let h = 1e-3 * scale;
+            let states: Vec<Vec<f64>> = [h, 2.0 * h]
+                .iter()
+                .map(|&h| y0.iter().zip(&f).map(|(y, f)| y + h * f).collect())
+                .collect();
+            let mut dy = vec![0.0; 2 * n];
+            let mut k = 0;
+            c.bench_function(&format!("{name}/{}", form.name()), |b| {
+                b.iter(|| {
+                    k ^= 1;
+                    sys.rhs(black_box(t + h), black_box(&states[k]), &mut dy)
+                        .expect("an evaluation");
+                    black_box(&dy);
+                });
+            });
+        }
+    }
+}
+
+criterion_group!(benches, rhs);
+criterion_main!(benches);
