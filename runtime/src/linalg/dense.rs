@@ -242,7 +242,13 @@ mod power_tests {
         let slow = |x: f64| 2.0_f64.powi((-x.log2().round()).clamp(-1000.0, 1000.0) as i32);
         for k in -1000..=1000 {
             let p = 2.0_f64.powi(k);
-            for x in [p, p * (SQRT_2 - 1e-4), p * (SQRT_2 + 1e-4), p * 1.9, p * 0.75] {
+            for x in [
+                p,
+                p * (SQRT_2 - 1e-4),
+                p * (SQRT_2 + 1e-4),
+                p * 1.9,
+                p * 0.75,
+            ] {
                 assert_eq!(power_of_two_inverse(x), slow(x), "{x:e}");
                 assert_eq!(power_of_two_inverse(-x), slow(x), "{x:e}");
             }
