@@ -3,6 +3,7 @@
 
 mod joints;
 mod models;
+mod poses;
 
 use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff::{Mechanism, MechanismExt};
