@@ -41,7 +41,12 @@ pub fn ranges(rows: &[Vec<f64>], count: usize) -> Option<Vec<(f64, f64)>> {
 ///
 /// # Errors
 /// The solve's failure, as a message.
-pub fn accelerations(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Result<Vec<f64>, String> {
+pub fn accelerations(
+    model: &dyn Mechanism,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<Vec<f64>, String> {
     let info = model.info();
     let mut ws = Workspace::new(info).map_err(|e| e.to_string())?;
     let params = DynamicsParams {

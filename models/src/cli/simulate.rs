@@ -424,7 +424,10 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
         let finals = outputs::values(model, t, q, qd);
         let rows = outputs::along(model, run);
         let ranges = outputs::ranges(&rows, finals.len()).unwrap_or_default();
-        let _ = writeln!(w, "outputs      final value (smallest, largest along the run)");
+        let _ = writeln!(
+            w,
+            "outputs      final value (smallest, largest along the run)"
+        );
         for ((s, v), (lo, hi)) in info.outputs.iter().zip(&finals).zip(ranges) {
             let _ = writeln!(w, "  {:<12} {v:.9e} ({lo:.6e}, {hi:.6e})", s.name);
         }
