@@ -7,11 +7,6 @@ mod misuse {
     fn kinetic_energy() -> f64 {
         0.5 * (x.dot().powi(2) + y.dot().powi(2))
     }
-    /// A velocity in a gap.
-    #[contact(e)]
-    fn moving() -> f64 {
-        y - x.dot()
-    }
     /// No coordinate in the gap.
     #[contact(e)]
     fn nowhere() -> f64 {
