@@ -206,7 +206,11 @@ fn named_constant(v: f64) -> Option<TokenStream> {
         (c::FRAC_PI_6, "FRAC_PI_6"),
         (c::SQRT_2, "SQRT_2"),
     ];
-    let (sign, a) = if v < 0.0 { (quote!(-), -v) } else { (quote!(), v) };
+    let (sign, a) = if v < 0.0 {
+        (quote!(-), -v)
+    } else {
+        (quote!(), v)
+    };
     table.iter().find(|(x, _)| *x == a).map(|(_, name)| {
         let name = Ident::new(name, Span::call_site());
         quote!(#sign ::core::f64::consts::#name)
