@@ -501,6 +501,13 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
+    /// The masses of the bodies of [`Info::bodies`] (one value per body), at the
+    /// current parameters; `t` and `q` are there for the rare mass that depends on them.
+    fn body_masses(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
     /// The named outputs of [`Info::outputs`].
     fn outputs(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
         let _ = (t, q, qd);

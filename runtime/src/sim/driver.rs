@@ -43,8 +43,12 @@ const MAX_GRID_ROWS: f64 = (1_u64 << 26) as f64;
 /// The output times in $(t_0, t_\text{end}]$.
 fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErrorKind> {
     let bad = |value| SimErrorKind::InvalidTimes { t0, t_end, value };
-    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+    if !(t0.is_finite() && t_end.is_finite() && t_end >= t0) {
         return Err(bad(t_end));
+    }
+    if t_end == t0 {
+        // A run of zero span: assembly and the initial row only.
+        return Ok(Vec::new());
     }
     let span = t_end - t0;
     match output {
@@ -296,6 +300,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
+    }
+    if t_end == t0 {
+        return Ok(rec.run(None));
     }
 
     // Integrator.

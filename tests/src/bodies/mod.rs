@@ -2,6 +2,7 @@
 //! free body (math-spec V12), and every joint type against finite differences.
 
 mod joints;
+mod masses;
 mod models;
 
 use pfaff::sim::{Formulation, Method, Simulation};

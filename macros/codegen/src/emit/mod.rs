@@ -584,6 +584,10 @@ fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream)
             false,
         ));
     }
+    if !b.bodies.is_empty() {
+        let masses: Vec<ExprId> = b.bodies.iter().map(|b| b.mass).collect();
+        fns.extend(vector_fn(g, names, "body_masses", &masses, false));
+    }
     quote! {
         frames: &[#(#frames),*],
         points: &[#(#points),*],
