@@ -24,6 +24,8 @@
 //! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
 //!   partitioning, projection or Baumgarte stabilization, any integrator, output at
 //!   requested times, monitors and work-precision sweeps.
+//! - [`ImpactSolver`]: the generalized impulse–momentum solve of an impact with
+//!   holonomic and non-holonomic constraints ([`Impact`]), augmented and partitioned.
 //! - [`linearize()`]: the linearized reduced system and its eigenvalues.
 //! - [`Error`]: every module's error, joined.
 
@@ -34,6 +36,7 @@ mod dynamics;
 mod error;
 mod ext;
 pub mod free_motion;
+mod impact;
 mod kinematics;
 mod linalg;
 mod linearize;
@@ -58,6 +61,7 @@ pub use ext::{DerivativeCheck, MechanismExt, Residuals};
 pub use free_motion::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
 };
+pub use impact::{Impact, ImpactError, ImpactSolver};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
