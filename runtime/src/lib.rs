@@ -24,6 +24,8 @@
 //! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
 //!   partitioning, projection or Baumgarte stabilization, any integrator, output at
 //!   requested times, monitors and work-precision sweeps.
+//! - [`ImpactSolver`]: the generalized impulse–momentum solve of an impact with
+//!   holonomic and non-holonomic constraints ([`Impact`]), augmented and partitioned.
 //! - [`linearize()`]: the linearized reduced system and its eigenvalues.
 //! - [`PoseExt`]: frame poses and points as nalgebra types ([`nalgebra`] is re-exported).
 //! - [`replay`]: the JSON trajectory format (times, poses, outputs, the drawing) for
@@ -40,6 +42,7 @@ mod dynamics;
 mod error;
 mod ext;
 pub mod free_motion;
+mod impact;
 mod kinematics;
 mod linalg;
 mod linearize;
@@ -67,6 +70,7 @@ pub use ext::{DerivativeCheck, MechanismExt, Residuals};
 pub use free_motion::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
 };
+pub use impact::{Impact, ImpactError, ImpactSolver};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,

@@ -540,6 +540,21 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
+    /// The time partials `∂gap/∂t` of the contacts (length [`Info::ncontacts`]), so that
+    /// the normal velocity is `v_n = D q̇ + ∂gap/∂t`; zero for gaps that do not depend on
+    /// time.
+    fn contact_rate(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// `γ_c = −(D q̇)_q q̇ − 2 D_t q̇ − gap_tt`, so that `D q̈ = γ_c` keeps a closed contact
+    /// closed (length [`Info::ncontacts`]); used by resting contact.
+    fn contact_gamma(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let _ = (t, q, qd);
+        out.fill(0.0);
+    }
+
     /// The values of data slot `index` ([`Info::data`]).
     fn data(&self, index: usize) -> &[f64] {
         let _ = index;
