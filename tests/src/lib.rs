@@ -15,6 +15,10 @@ mod free_motion;
 #[cfg(test)]
 mod fuzz;
 #[cfg(test)]
+mod impacts;
+#[cfg(test)]
+mod replay;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;

@@ -6,9 +6,6 @@ use super::error::CliError;
 use super::scene::Scene;
 use super::setup;
 
-/// Contacts are not modelled yet; the column is there so scripts need not change.
-const CONTACTS: usize = 0;
-
 /// The table of `pfaff list`.
 pub fn list() -> String {
     let mut w = String::new();
@@ -27,7 +24,7 @@ pub fn list() -> String {
             info.nq(),
             info.nh(),
             info.nnh(),
-            CONTACTS,
+            info.ncontacts(),
             Scene::of(e.name)
                 .t_end
                 .to_string()
@@ -95,7 +92,17 @@ pub fn show(name: &str) -> Result<String, CliError> {
         let _ = writeln!(w, "  {:<10} {}", c.name, first_line(c.doc));
     }
     body_level(&mut w, model.as_ref(), &q0);
-    let _ = writeln!(w, "\ncontacts ({CONTACTS})");
+    let _ = writeln!(w, "\ncontacts ({}):", info.ncontacts());
+    for c in info.contacts {
+        let e = info.parameters[c.restitution as usize].name;
+        let _ = writeln!(
+            w,
+            "  {:<10} restitution {:<6} {}",
+            c.name,
+            e,
+            first_line(c.doc)
+        );
+    }
     let scene = Scene::of(info.name);
     let _ = writeln!(w, "default span: 0 to {} s ({})", scene.t_end, scene.span);
     if let Some(s) = scene.steady {

@@ -88,6 +88,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     started: Instant,
     y: &'a mut [f64],
     overridden: Vec<crate::OverriddenVelocity>,
+    repartition_times: Vec<f64>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -175,6 +176,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             monitors: self.monitors,
             redundant_constraints: self.sys.point.redundant.clone(),
             overridden_velocities: self.overridden.clone(),
+            repartition_times: self.repartition_times.clone(),
         }
     }
 
@@ -217,6 +219,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
             overridden_velocities: Vec::new(),
+            repartition_times: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -297,6 +300,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         started,
         y: &mut y,
         overridden,
+        repartition_times: Vec::new(),
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -359,6 +363,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 steps: sim.max_steps
             });
         }
+        let partitions = rec.sys.point.kin.repartitions();
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
@@ -381,6 +386,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Correction::Changed => check!(stepper.set_state(rec.y).map_err(ode)),
         }
         check!(rec.sys.accept(t));
+        if rec.sys.point.kin.repartitions() > partitions {
+            rec.repartition_times.push(t);
+        }
         // Its row (or its monitors), then the rows of the output times the step
         // passed, which overwrite the full state.
         if steps_mode {

@@ -4,6 +4,7 @@
 mod joints;
 mod masses;
 mod models;
+mod poses;
 mod reactions;
 
 use pfaff::sim::{Formulation, Method, Simulation};
