@@ -201,6 +201,7 @@ fn kind_name(kind: &SimErrorKind) -> &'static str {
         SimErrorKind::NonFinite { .. } => "non_finite",
         SimErrorKind::Analysis(_) => "analysis",
         SimErrorKind::Integrator(_) => "integrator",
+        SimErrorKind::Impact(_) => "impact",
     }
 }
 
