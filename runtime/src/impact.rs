@@ -38,6 +38,9 @@
 //! [`ImpactSolver`] holds its scratch: after [`ImpactSolver::new`], a solve allocates
 //! only the [`Impact`] it returns.
 
+// Index loops mirror the block structure of the augmented matrix.
+#![allow(clippy::needless_range_loop)]
+
 use crate::linalg::dense::DenseLu;
 use crate::workspace::{check_finite, scatter_row_major, EvalError, Quantity, Workspace};
 use crate::{

@@ -4,6 +4,7 @@
 
 mod args;
 mod error;
+mod impacts;
 mod linearize;
 mod list;
 mod outputs;
