@@ -16,7 +16,8 @@
 //! - [`Dynamics`]: accelerations and multipliers from the augmented system, dense or
 //!   sparse, with minimum-norm multipliers for redundant constraints.
 //! - [`ReactionAnalysis`]: multipliers and generalized constraint forces per named
-//!   constraint ([`Reactions`]), at a state or along a trajectory.
+//!   constraint ([`Reactions`]), at a state or along a trajectory; per joint, the force
+//!   and torque it transmits ([`JointReactions`]).
 //! - [`FreeMotion`]: the explicit multiplier formula and free-motion analysis of the
 //!   second seed paper, with the inverse problems ([`free_motion`]).
 //! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
@@ -27,23 +28,32 @@
 //! - [`ImpactSolver`]: the generalized impulse–momentum solve of an impact with
 //!   holonomic and non-holonomic constraints ([`Impact`]), augmented and partitioned.
 //! - [`linearize()`]: the linearized reduced system and its eigenvalues.
+//! - [`PoseExt`]: frame poses and points as nalgebra types ([`nalgebra`] is re-exported).
+//! - [`replay`]: the JSON trajectory format (times, poses, outputs, the drawing) for
+//!   viewers and other tools.
 //! - [`Error`]: every module's error, joined.
 
+/// nalgebra, in the version whose types [`PoseExt`] returns.
+pub use nalgebra;
 pub use pfaff_macros::mechanism;
 
 mod assembly;
+mod drawing;
 mod dynamics;
 mod error;
 mod ext;
 pub mod free_motion;
 mod impact;
+mod joint_reactions;
 mod kinematics;
 mod linalg;
 mod linearize;
 mod mechanism;
 pub mod ode;
 mod partition;
+mod pose;
 mod reactions;
+pub mod replay;
 mod scale;
 pub mod sim;
 mod workspace;
@@ -52,6 +62,7 @@ pub use assembly::{
     AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
     CONSISTENCY_TOLERANCE,
 };
+pub use drawing::{DrawPoint, Drawing, Shape, ShapeKind};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
     DEFAULT_CROSSOVER,
@@ -62,6 +73,7 @@ pub use free_motion::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
 };
 pub use impact::{Impact, ImpactError, ImpactSolver};
+pub use joint_reactions::{JointReaction, JointReactions, Wrench};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
@@ -71,6 +83,7 @@ pub use mechanism::{
     Parameter, Pattern, Point, Symbol, TimeDependence,
 };
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
+pub use pose::{isometry2_from_raw, isometry_from_raw, quaternion_from_raw, PoseExt};
 pub use reactions::{
     ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,
 };
@@ -79,6 +92,7 @@ pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Works
 /// Items used by generated code. Not part of the public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::drawing::{DrawPoint, Drawing, Shape, ShapeKind};
     pub use crate::mechanism::{
         Body, Contact, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
         Parameter, Point, Symbol, TimeDependence,

@@ -501,6 +501,20 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
+    /// How the model asks to be drawn: shapes over drawing points (see
+    /// [`Drawing`](crate::Drawing)). The default draws nothing.
+    fn drawing(&self) -> &'static crate::Drawing {
+        &crate::Drawing::EMPTY
+    }
+
+    /// The values of [`drawing`](Self::drawing) at `(t, q)`: the global coordinates of
+    /// its points, 3 per point, then its scalars ([`Drawing::len`](crate::Drawing::len)
+    /// values).
+    fn drawing_values(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
     /// The masses of the bodies of [`Info::bodies`] (one value per body), at the
     /// current parameters; `t` and `q` are there for the rare mass that depends on them.
     fn body_masses(&self, t: f64, q: &[f64], out: &mut [f64]) {

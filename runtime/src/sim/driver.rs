@@ -88,6 +88,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     started: Instant,
     y: &'a mut [f64],
     overridden: Vec<crate::OverriddenVelocity>,
+    repartition_times: Vec<f64>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -178,6 +179,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             overridden_velocities: self.overridden.clone(),
             impacts,
             contact_events,
+            repartition_times: self.repartition_times.clone(),
         }
     }
 
@@ -222,6 +224,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             overridden_velocities: Vec::new(),
             impacts: Vec::new(),
             contact_events: Vec::new(),
+            repartition_times: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -317,6 +320,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         started,
         y: &mut y,
         overridden,
+        repartition_times: Vec::new(),
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -385,6 +389,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             });
         }
         let t_prev = stepper.t();
+        let partitions = rec.sys.point.kin.repartitions();
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
@@ -472,6 +477,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Correction::Changed => check!(stepper.set_state(rec.y).map_err(ode)),
         }
         check!(rec.sys.accept(t));
+        if rec.sys.point.kin.repartitions() > partitions {
+            rec.repartition_times.push(t);
+        }
         // Its row (or its monitors), then the rows of the output times the step
         // passed, which overwrite the full state.
         if steps_mode {

@@ -212,6 +212,9 @@ pub struct Run {
     pub impacts: Vec<crate::Impact>,
     /// Contacts that came to rest (accumulated impacts) and released, in time order.
     pub contact_events: Vec<super::ContactEvent>,
+    /// The times of the accepted steps at which the partition was chosen anew (one per
+    /// re-partition counted in [`Stats::repartitions`] after the start).
+    pub repartition_times: Vec<f64>,
 }
 
 impl Run {

@@ -4,6 +4,8 @@
 mod joints;
 mod masses;
 mod models;
+mod poses;
+mod reactions;
 
 use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff::{Mechanism, MechanismExt};
