@@ -33,6 +33,8 @@
 // each file holds `pub mod <name> { … }` and is mounted under a private name here.
 #[path = "andrews.rs"]
 mod andrews_model;
+#[path = "bicycle.rs"]
+mod bicycle_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
 #[path = "free_body.rs"]
@@ -41,6 +43,8 @@ mod free_body_model;
 mod parallelogram_model;
 #[path = "pendulum.rs"]
 mod pendulum_model;
+#[path = "rolling_disk.rs"]
+mod rolling_disk_model;
 #[path = "seed2_example1.rs"]
 mod seed2_example1_model;
 #[path = "seed2_example2.rs"]
@@ -53,18 +57,23 @@ mod sleigh_model;
 mod slider_crank_bodies_model;
 #[path = "slider_crank.rs"]
 mod slider_crank_model;
+#[path = "spatial_four_bar.rs"]
+mod spatial_four_bar_model;
 
 pub use andrews_model::andrews;
+pub use bicycle_model::bicycle;
 pub use car_axis_model::car_axis;
 pub use free_body_model::free_body;
 pub use parallelogram_model::parallelogram;
 pub use pendulum_model::pendulum;
+pub use rolling_disk_model::rolling_disk;
 pub use seed2_example1_model::seed2_example1;
 pub use seed2_example2_model::seed2_example2;
 pub use sleigh_bodies_model::sleigh_bodies;
 pub use sleigh_model::sleigh;
 pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
+pub use spatial_four_bar_model::spatial_four_bar;
 
 /// A built-in model as listed by the command-line program.
 #[derive(Clone, Copy, Debug)]
@@ -102,6 +111,21 @@ static ALL: &[Entry] = &[
         name: "free_body",
         summary: "torque-free spatial rigid body with Euler parameters (math-spec V12)",
         make: || Box::new(free_body::Model::default()),
+    },
+    Entry {
+        name: "rolling_disk",
+        summary: "thin uniform disk rolling without slip on a plane",
+        make: || Box::new(rolling_disk::Model::default()),
+    },
+    Entry {
+        name: "bicycle",
+        summary: "Whipple bicycle benchmark (Meijaard, Papadopoulos, Ruina, Schwab 2007)",
+        make: || Box::new(bicycle::Model::default()),
+    },
+    Entry {
+        name: "spatial_four_bar",
+        summary: "spatial four-bar (revolute, spherical, universal) with Euler parameters",
+        make: || Box::new(spatial_four_bar::Model::default()),
     },
     Entry {
         name: "andrews",

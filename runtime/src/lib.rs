@@ -60,7 +60,8 @@ pub use free_motion::{
 };
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
-    linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
+    linearize, linearize_with, Eigenvalue, Linearization, LinearizeError, LinearizeMethod,
+    LinearizeParams, StateComponent, States,
 };
 pub use mechanism::{
     Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,

@@ -15,6 +15,8 @@ mod free_motion;
 #[cfg(test)]
 mod fuzz;
 #[cfg(test)]
+mod linear;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;

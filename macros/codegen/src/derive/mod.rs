@@ -19,6 +19,7 @@
 pub mod bodies;
 mod checks;
 pub mod free_motion;
+pub mod linear;
 
 use crate::ctxt::Ctxt;
 use crate::model::expr::{Context, Translator};
@@ -87,6 +88,8 @@ pub struct Derived {
     pub bodies: Option<bodies::BodyLevel>,
     /// Named outputs: name, docs, expression.
     pub outputs: Vec<(String, String, ExprId)>,
+    /// The linearization Jacobian, for `#[mechanism(linearize)]`.
+    pub linear: Option<linear::Linear>,
 }
 
 fn idx(i: usize) -> u32 {
@@ -468,7 +471,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     for (name, docs, e) in outputs {
         outs.push((name, docs, e?));
     }
-    Some(Derived {
+    let mut derived = Derived {
         holonomic_names,
         nonholonomic_names,
         bodies: body_level,
@@ -491,7 +494,13 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         homogeneous,
         conservative,
         free_motion,
-    })
+        linear: None,
+    };
+    // Not in a raw graph: the naive operation counts measure the simulation's functions.
+    if model.linearize && checking {
+        derived.linear = Some(linear::derive(g, &derived, n));
+    }
+    Some(derived)
 }
 
 /// The entries of row `r` of a pattern-ordered matrix.

@@ -54,6 +54,8 @@ pub struct Model {
     /// Body-level declarations (frames, points, bodies, joints, force elements), in
     /// declaration order.
     pub decls: Vec<Decl>,
+    /// `#[mechanism(linearize)]`: emit the linearization Jacobian.
+    pub linearize: bool,
 }
 
 impl Model {
@@ -116,6 +118,7 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         definitions: Vec::new(),
         outputs: Vec::new(),
         decls: Vec::new(),
+        linearize: ast.linearize,
     };
     let mut seen: HashMap<String, syn::Ident> = HashMap::new();
     let mut declare = |name: &syn::Ident| {
