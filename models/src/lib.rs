@@ -18,6 +18,13 @@
 //! | [`slider_crank_bodies`] | as `slider_crank`, from bodies and joints | 9 holonomic |
 //! | [`sleigh_bodies`] | as `sleigh`, from a body and a knife edge | 1 non-holonomic |
 //! | [`free_body`] | `x y z e0 e1 e2 e3` | 1 holonomic (Euler-parameter normalization) |
+//! | [`bouncing_ball`] | `y` | 1 contact |
+//! | [`falling_rod`] | `x y phi` | 2 contacts |
+//! | [`pendulum_floor`] | `x1 y1 phi1 x2 y2 phi2` | 4 holonomic, 1 contact (math-spec V15) |
+//! | [`sleigh_wall`] | `x y phi` | 1 non-holonomic, 1 contact (math-spec V16) |
+//! | [`body_impact`] | `x y phi` | 1 contact (math-spec V13) |
+//! | [`two_body_impact`] | `x1 y1 phi1 x2 y2 phi2` | 1 contact (math-spec V14) |
+//! | [`newtons_cradle`] | `theta1 theta2 theta3` | 2 contacts |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -35,12 +42,22 @@
 mod andrews_model;
 #[path = "bicycle.rs"]
 mod bicycle_model;
+#[path = "body_impact.rs"]
+mod body_impact_model;
+#[path = "bouncing_ball.rs"]
+mod bouncing_ball_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
+#[path = "falling_rod.rs"]
+mod falling_rod_model;
 #[path = "free_body.rs"]
 mod free_body_model;
+#[path = "newtons_cradle.rs"]
+mod newtons_cradle_model;
 #[path = "parallelogram.rs"]
 mod parallelogram_model;
+#[path = "pendulum_floor.rs"]
+mod pendulum_floor_model;
 #[path = "pendulum.rs"]
 mod pendulum_model;
 #[path = "rolling_disk.rs"]
@@ -53,6 +70,8 @@ mod seed2_example2_model;
 mod sleigh_bodies_model;
 #[path = "sleigh.rs"]
 mod sleigh_model;
+#[path = "sleigh_wall.rs"]
+mod sleigh_wall_model;
 #[path = "slider_crank_bodies.rs"]
 mod slider_crank_bodies_model;
 #[path = "slider_crank.rs"]
@@ -62,15 +81,21 @@ mod spatial_four_bar_model;
 
 pub use andrews_model::andrews;
 pub use bicycle_model::bicycle;
+pub use body_impact_model::{body_impact, two_body_impact};
+pub use bouncing_ball_model::bouncing_ball;
 pub use car_axis_model::car_axis;
+pub use falling_rod_model::falling_rod;
 pub use free_body_model::free_body;
+pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
+pub use pendulum_floor_model::pendulum_floor;
 pub use pendulum_model::pendulum;
 pub use rolling_disk_model::rolling_disk;
 pub use seed2_example1_model::seed2_example1;
 pub use seed2_example2_model::seed2_example2;
 pub use sleigh_bodies_model::sleigh_bodies;
 pub use sleigh_model::sleigh;
+pub use sleigh_wall_model::sleigh_wall;
 pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
 pub use spatial_four_bar_model::spatial_four_bar;
@@ -156,6 +181,41 @@ static ALL: &[Entry] = &[
         name: "parallelogram",
         summary: "parallelogram linkage with a redundant third crank (reactions of redundant constraints)",
         make: || Box::new(parallelogram::Model::default()),
+    },
+    Entry {
+        name: "bouncing_ball",
+        summary: "ball bouncing on the ground until the impacts accumulate, then resting",
+        make: || Box::new(bouncing_ball::Model::default()),
+    },
+    Entry {
+        name: "falling_rod",
+        summary: "uniform rod falling at an angle onto a smooth floor (two end contacts)",
+        make: || Box::new(falling_rod::Model::default()),
+    },
+    Entry {
+        name: "pendulum_floor",
+        summary: "double pendulum striking a floor, impulsive joint reactions (math-spec V15)",
+        make: || Box::new(pendulum_floor::Model::default()),
+    },
+    Entry {
+        name: "sleigh_wall",
+        summary: "Chaplygin sleigh striking a wall, jump of the non-holonomic reaction (math-spec V16)",
+        make: || Box::new(sleigh_wall::Model::default()),
+    },
+    Entry {
+        name: "body_impact",
+        summary: "free planar body striking a floor with a corner (math-spec V13)",
+        make: || Box::new(body_impact::Model::default()),
+    },
+    Entry {
+        name: "two_body_impact",
+        summary: "two free planar bodies colliding, a disk and a rod (math-spec V14)",
+        make: || Box::new(two_body_impact::Model::default()),
+    },
+    Entry {
+        name: "newtons_cradle",
+        summary: "Newton's cradle, three balls on strings (sequential impacts)",
+        make: || Box::new(newtons_cradle::Model::default()),
     },
 ];
 

@@ -76,6 +76,7 @@ fn check_keys(v: &Value, with_error: bool) {
         "integrator",
         "max_violation",
         "model",
+        "outputs",
         "rtol",
         "stats",
         "t_end",
@@ -148,7 +149,7 @@ fn simulate_json_is_one_object_with_the_documented_keys() {
         .map(String::as_str)
         .collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["lambda", "q", "qd", "t"]);
+    assert_eq!(keys, ["lambda", "outputs", "q", "qd", "qdd", "t"]);
     let (x, y) = (
         fin["q"]["x"].as_f64().unwrap(),
         fin["q"]["y"].as_f64().unwrap(),

@@ -32,4 +32,7 @@ pub enum Error {
     /// Linearization.
     #[error(transparent)]
     Linearize(#[from] LinearizeError),
+    /// The impulse solve of an impact.
+    #[error(transparent)]
+    Impact(#[from] crate::impact::ImpactError),
 }

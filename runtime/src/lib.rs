@@ -24,23 +24,34 @@
 //! - [`sim`]: simulation of a mechanism ([`sim::Simulation`]): assembly, coordinate
 //!   partitioning, projection or Baumgarte stabilization, any integrator, output at
 //!   requested times, monitors and work-precision sweeps.
+//! - [`ImpactSolver`]: the generalized impulse–momentum solve of an impact with
+//!   holonomic and non-holonomic constraints ([`Impact`]), augmented and partitioned.
 //! - [`linearize()`]: the linearized reduced system and its eigenvalues.
+//! - [`PoseExt`]: frame poses and points as nalgebra types ([`nalgebra`] is re-exported).
+//! - [`replay`]: the JSON trajectory format (times, poses, outputs, the drawing) for
+//!   viewers and other tools.
 //! - [`Error`]: every module's error, joined.
 
+/// nalgebra, in the version whose types [`PoseExt`] returns.
+pub use nalgebra;
 pub use pfaff_macros::mechanism;
 
 mod assembly;
+mod drawing;
 mod dynamics;
 mod error;
 mod ext;
 pub mod free_motion;
+mod impact;
 mod kinematics;
 mod linalg;
 mod linearize;
 mod mechanism;
 pub mod ode;
 mod partition;
+mod pose;
 mod reactions;
+pub mod replay;
 mod scale;
 pub mod sim;
 mod workspace;
@@ -49,6 +60,7 @@ pub use assembly::{
     AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
     CONSISTENCY_TOLERANCE,
 };
+pub use drawing::{DrawPoint, Drawing, Shape, ShapeKind};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
     DEFAULT_CROSSOVER,
@@ -58,6 +70,7 @@ pub use ext::{DerivativeCheck, MechanismExt, Residuals};
 pub use free_motion::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
 };
+pub use impact::{Impact, ImpactError, ImpactSolver};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, linearize_with, Eigenvalue, Linearization, LinearizeError, LinearizeMethod,
@@ -68,6 +81,7 @@ pub use mechanism::{
     Parameter, Pattern, Point, Symbol, TimeDependence,
 };
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
+pub use pose::{isometry2_from_raw, isometry_from_raw, quaternion_from_raw, PoseExt};
 pub use reactions::{
     ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,
 };
@@ -76,6 +90,7 @@ pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Works
 /// Items used by generated code. Not part of the public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::drawing::{DrawPoint, Drawing, Shape, ShapeKind};
     pub use crate::mechanism::{
         Body, Contact, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
         Parameter, Point, Symbol, TimeDependence,

@@ -506,6 +506,27 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
+    /// How the model asks to be drawn: shapes over drawing points (see
+    /// [`Drawing`](crate::Drawing)). The default draws nothing.
+    fn drawing(&self) -> &'static crate::Drawing {
+        &crate::Drawing::EMPTY
+    }
+
+    /// The values of [`drawing`](Self::drawing) at `(t, q)`: the global coordinates of
+    /// its points, 3 per point, then its scalars ([`Drawing::len`](crate::Drawing::len)
+    /// values).
+    fn drawing_values(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The masses of the bodies of [`Info::bodies`] (one value per body), at the
+    /// current parameters; `t` and `q` are there for the rare mass that depends on them.
+    fn body_masses(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
     /// The named outputs of [`Info::outputs`].
     fn outputs(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
         let _ = (t, q, qd);
@@ -549,6 +570,21 @@ pub trait Mechanism {
         out: &mut [f64],
     ) {
         let _ = (t, q, qd, inputs);
+        out.fill(0.0);
+    }
+
+    /// The time partials `∂gap/∂t` of the contacts (length [`Info::ncontacts`]), so that
+    /// the normal velocity is `v_n = D q̇ + ∂gap/∂t`; zero for gaps that do not depend on
+    /// time.
+    fn contact_rate(&self, t: f64, q: &[f64], out: &mut [f64]) {
+        let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// `γ_c = −(D q̇)_q q̇ − 2 D_t q̇ − gap_tt`, so that `D q̈ = γ_c` keeps a closed contact
+    /// closed (length [`Info::ncontacts`]); used by resting contact.
+    fn contact_gamma(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let _ = (t, q, qd);
         out.fill(0.0);
     }
 

@@ -45,6 +45,10 @@ pub enum Quantity {
     Accelerations,
     /// Computed multipliers `λ`.
     Multipliers,
+    /// The contact gaps.
+    ContactGaps,
+    /// The contact normal Jacobian `D` (or the gaps' time partials).
+    ContactJacobian,
 }
 
 impl fmt::Display for Quantity {
@@ -64,6 +68,8 @@ impl fmt::Display for Quantity {
             Self::NonholonomicGamma => "non-holonomic acceleration term `gamma_nh`",
             Self::Accelerations => "accelerations `q''`",
             Self::Multipliers => "multipliers `lambda`",
+            Self::ContactGaps => "contact gaps",
+            Self::ContactJacobian => "contact normal Jacobian `D`",
         })
     }
 }
@@ -228,7 +234,7 @@ pub(crate) fn check_state(
     Ok(())
 }
 
-fn check_pattern(
+pub(crate) fn check_pattern(
     model: &'static str,
     quantity: Quantity,
     pattern: Pattern,

@@ -15,7 +15,11 @@ mod free_motion;
 #[cfg(test)]
 mod fuzz;
 #[cfg(test)]
+mod impacts;
+#[cfg(test)]
 mod linear;
+#[cfg(test)]
+mod replay;
 #[cfg(test)]
 mod sim;
 #[cfg(test)]

@@ -41,6 +41,10 @@ fn functions(d: &Derived) -> Vec<Vec<ExprId>> {
         d.gamma_nh.clone(),
         vec![d.kinetic],
         vec![d.potential],
+        d.contacts.list.iter().map(|k| k.gap).collect(),
+        e(&d.contacts.jacobian),
+        d.contacts.list.iter().map(|k| k.rate).collect(),
+        d.contacts.list.iter().map(|k| k.gamma).collect(),
     ]
 }
 
@@ -132,6 +136,17 @@ impl Analysis {
             }
             let _ = writeln!(s, "g[{}] = {}", item.name, f(d.gb[r]));
             let _ = writeln!(s, "γ_nh[{}] = {}", item.name, f(d.gamma_nh[r]));
+        }
+        for (r, k) in d.contacts.list.iter().enumerate() {
+            let e = &m.params[k.restitution as usize].name;
+            let _ = writeln!(s, "gap[{}] = {} (restitution {e})", k.name, f(k.gap));
+            for en in d.contacts.jacobian.iter().filter(|en| en.row as usize == r) {
+                let _ = writeln!(s, "D[{}, {}] = {}", k.name, coord(en.col), f(en.expr));
+            }
+            if !g.is_zero(k.rate) {
+                let _ = writeln!(s, "gap_t[{}] = {}", k.name, f(k.rate));
+            }
+            let _ = writeln!(s, "γ_c[{}] = {}", k.name, f(k.gamma));
         }
         let _ = writeln!(
             s,

@@ -6,40 +6,39 @@ use super::error::CliError;
 use super::scene::Scene;
 use super::setup;
 
-/// Contacts are not modelled yet; the column is there so scripts need not change.
-const CONTACTS: usize = 0;
-
 /// The table of `pfaff list`.
 pub fn list() -> String {
     let mut w = String::new();
     let _ = writeln!(
         w,
-        "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8}  description",
-        "model", "nq", "hol", "nhol", "contacts", "t_end"
+        "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  description",
+        "model", "nq", "hol", "nhol", "contacts", "t_end", "bodies", "joints"
     );
     for e in pfaff_models::all() {
         let model = (e.make)();
         let info = model.info();
         let _ = writeln!(
             w,
-            "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8}  {}",
+            "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  {}",
             e.name,
             info.nq(),
             info.nh(),
             info.nnh(),
-            CONTACTS,
+            info.ncontacts(),
             Scene::of(e.name)
                 .t_end
                 .to_string()
                 .chars()
                 .take(8)
                 .collect::<String>(),
+            info.bodies.len(),
+            info.joints.len(),
             e.summary
         );
     }
     let _ = writeln!(
         w,
-        "\nnq coordinates, hol holonomic and nhol non-holonomic constraints; t_end the default span [s] of `pfaff simulate`"
+        "\nnq coordinates, hol holonomic and nhol non-holonomic constraints; t_end the default span [s] of `pfaff simulate`;\nbodies and joints of the models written at the body level"
     );
     w
 }
@@ -92,7 +91,18 @@ pub fn show(name: &str) -> Result<String, CliError> {
     for c in info.nonholonomic {
         let _ = writeln!(w, "  {:<10} {}", c.name, first_line(c.doc));
     }
-    let _ = writeln!(w, "\ncontacts ({CONTACTS})");
+    body_level(&mut w, model.as_ref(), &q0);
+    let _ = writeln!(w, "\ncontacts ({}):", info.ncontacts());
+    for c in info.contacts {
+        let e = info.parameters[c.restitution as usize].name;
+        let _ = writeln!(
+            w,
+            "  {:<10} restitution {:<6} {}",
+            c.name,
+            e,
+            first_line(c.doc)
+        );
+    }
     let scene = Scene::of(info.name);
     let _ = writeln!(w, "default span: 0 to {} s ({})", scene.t_end, scene.span);
     if let Some(s) = scene.steady {
@@ -106,4 +116,64 @@ pub fn show(name: &str) -> Result<String, CliError> {
         );
     }
     Ok(w)
+}
+
+/// A joint's rows, `name (first..last)` of one kind of constraint, or `-`.
+fn rows(names: &[pfaff::Symbol], (start, len): (u32, u32)) -> String {
+    let (a, n) = (start as usize, len as usize);
+    match names.get(a..a + n) {
+        Some([]) | None => "-".to_owned(),
+        Some(rows) => rows.iter().map(|s| s.name).collect::<Vec<_>>().join(" "),
+    }
+}
+
+/// The body level of `pfaff show`: bodies, joints, points, outputs.
+fn body_level(w: &mut String, model: &dyn pfaff::Mechanism, q0: &[f64]) {
+    let info = model.info();
+    let frame = |k: Option<u32>| {
+        k.and_then(|k| info.frames.get(k as usize))
+            .map_or("ground", |f| f.name)
+    };
+    let mut masses = vec![0.0; info.bodies.len()];
+    if !masses.is_empty() {
+        model.body_masses(0.0, q0, &mut masses);
+    }
+    let _ = writeln!(w, "\nbodies ({}):", info.bodies.len());
+    for (b, m) in info.bodies.iter().zip(&masses) {
+        let _ = writeln!(
+            w,
+            "  {:<10} mass {:<10} frame {:<10} {}",
+            b.name,
+            m,
+            frame(Some(b.frame)),
+            first_line(b.doc)
+        );
+    }
+    let _ = writeln!(w, "\njoints ({}):", info.joints.len());
+    for j in info.joints {
+        let _ = writeln!(
+            w,
+            "  {:<10} {:<16} {} - {}; holonomic rows: {}; non-holonomic rows: {}",
+            j.name,
+            format!("{:?}", j.kind),
+            frame(j.frames[0]),
+            frame(j.frames[1]),
+            rows(info.holonomic, j.holonomic),
+            rows(info.nonholonomic, j.nonholonomic),
+        );
+    }
+    let _ = writeln!(w, "\npoints ({}):", info.points.len());
+    for p in info.points {
+        let _ = writeln!(
+            w,
+            "  {:<10} in frame {:<10} {}",
+            p.name,
+            frame(Some(p.frame)),
+            first_line(p.doc)
+        );
+    }
+    let _ = writeln!(w, "\noutputs ({}):", info.outputs.len());
+    for o in info.outputs {
+        let _ = writeln!(w, "  {:<10} {}", o.name, first_line(o.doc));
+    }
 }

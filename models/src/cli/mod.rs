@@ -6,6 +6,7 @@ mod args;
 mod error;
 mod linearize;
 mod list;
+mod outputs;
 mod plot;
 mod precision;
 mod rhs_time;

@@ -13,7 +13,7 @@ use serde_json::{json, Map, Value};
 use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
 use super::error::{failed, usage, CliError};
 use super::scene::Scene;
-use super::{plot, setup};
+use super::{outputs, plot, setup};
 
 /// A validated simulation request.
 pub struct Request<'a> {
@@ -61,9 +61,9 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
     }
     positive("--atol", args.atol, true)?;
     let t_end = args.t_end.unwrap_or(scene.t_end);
-    if !t_end.is_finite() || t_end <= 0.0 {
+    if !t_end.is_finite() || t_end < 0.0 {
         return Err(usage(format!(
-            "--t-end {t_end} is not after the start time 0: expected a positive finite end time"
+            "--t-end {t_end} is before the start time 0: expected a finite end time, at least 0 (0 analyses the initial state)"
         )));
     }
     let mut notes = Vec::new();
@@ -71,7 +71,8 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
         positive("--step", h, false)?;
     }
     let step = args.step.map(|h| {
-        let min = min_step(0.0, t_end);
+        // A zero span takes no step; the floor is then that of a unit span.
+        let min = min_step(0.0, if t_end > 0.0 { t_end } else { 1.0 });
         if h < min {
             notes.push(format!(
                 "--step {h:e} is below the smallest step the time resolves over [0, {t_end}] s: {min:e} was used"
@@ -87,7 +88,7 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
     }
     let method = match args.integrator {
         IntegratorArg::Rk4 => Method::Rk4 {
-            h: step.unwrap_or(t_end / 1000.0),
+            h: step.unwrap_or(if t_end > 0.0 { t_end / 1000.0 } else { 1e-3 }),
         },
         IntegratorArg::Dopri5 => Method::Dopri5,
         IntegratorArg::Dop853 => Method::Dop853,
@@ -172,8 +173,11 @@ fn run_once(
     if let (Some(h), false) = (req.step, matches!(req.method, Method::Rk4 { .. })) {
         sim = sim.initial_step(h);
     }
-    sim = if dense {
+    sim = if dense && t_end > 0.0 {
         sim.output_every(t_end / req.args.samples as f64)
+    } else if !model.info().outputs.is_empty() {
+        // The range of the outputs along the run is taken over the recorded rows.
+        sim.output_steps()
     } else {
         sim.output_times(&[])
     };
@@ -236,15 +240,30 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         .chain(info.nonholonomic)
         .map(|s| s.name);
     let last = run.trajectory.len().checked_sub(1);
+    let output_names = || info.outputs.iter().map(|s| s.name);
     let final_ = last.map_or(Value::Null, |i| {
         let tr = &run.trajectory;
+        let (t, q, qd) = (tr.t[i], tr.q(i), tr.qd(i));
+        let qdd = outputs::accelerations(model, t, q, qd).map_or(Value::Null, |a| {
+            named(info.coordinates.iter().map(|s| s.name), &a)
+        });
         json!({
-            "t": tr.t[i],
-            "q": named(info.coordinates.iter().map(|s| s.name), tr.q(i)),
-            "qd": named(info.coordinates.iter().map(|s| s.name), tr.qd(i)),
+            "t": t,
+            "q": named(info.coordinates.iter().map(|s| s.name), q),
+            "qd": named(info.coordinates.iter().map(|s| s.name), qd),
+            "qdd": qdd,
             "lambda": named(constraints, tr.lambda(i)),
+            "outputs": named(output_names(), &outputs::values(model, t, q, qd)),
         })
     });
+    let rows = outputs::along(model, run);
+    let ranges = outputs::ranges(&rows, info.outputs.len()).unwrap_or_default();
+    let output_ranges = Value::Object(
+        output_names()
+            .zip(ranges)
+            .map(|(n, (lo, hi))| (n.to_owned(), json!({"min": lo, "max": hi})))
+            .collect::<Map<_, _>>(),
+    );
     let s = &run.stats;
     let m = &run.monitors;
     let mut obj = json!({
@@ -255,6 +274,7 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         "atol": req.args.atol,
         "t_end": req.t_end,
         "final": final_,
+        "outputs": output_ranges,
         "stats": {
             "steps": s.steps,
             "rejected": s.rejected,
@@ -386,6 +406,32 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
             );
         }
     }
+    if let (Some((t, q, qd)), true) = (run.final_state(), req.t_end == 0.0) {
+        // The initial state analysed: its accelerations.
+        let line = match outputs::accelerations(model, t, q, qd) {
+            Ok(a) => info
+                .coordinates
+                .iter()
+                .zip(a)
+                .map(|(c, v)| format!("{}'' = {v:.6}", c.name))
+                .collect::<Vec<_>>()
+                .join(", "),
+            Err(e) => format!("not computed: {e}"),
+        };
+        let _ = writeln!(w, "accelerations {line}");
+    }
+    if let (Some((t, q, qd)), false) = (run.final_state(), info.outputs.is_empty()) {
+        let finals = outputs::values(model, t, q, qd);
+        let rows = outputs::along(model, run);
+        let ranges = outputs::ranges(&rows, finals.len()).unwrap_or_default();
+        let _ = writeln!(
+            w,
+            "outputs      final value (smallest, largest along the run)"
+        );
+        for ((s, v), (lo, hi)) in info.outputs.iter().zip(&finals).zip(ranges) {
+            let _ = writeln!(w, "  {:<12} {v:.9e} ({lo:.6e}, {hi:.6e})", s.name);
+        }
+    }
     w
 }
 
@@ -406,8 +452,8 @@ fn no_energy(model: &pfaff::Info, run: &Run) -> &'static str {
 }
 
 /// Writes the CSV of the trajectory: `t`, the coordinates, the velocities (`NAME'`),
-/// the multipliers (`lambda_NAME`), `position_violation`, `velocity_violation` and
-/// `energy`.
+/// the model's named outputs, the multipliers (`lambda_NAME`), `position_violation`,
+/// `velocity_violation` and `energy`.
 pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), CliError> {
     let info = model.info();
     let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
@@ -415,6 +461,7 @@ pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), Cl
     let mut header = vec!["t".to_owned()];
     header.extend(info.coordinates.iter().map(|c| c.name.to_owned()));
     header.extend(info.coordinates.iter().map(|c| format!("{}'", c.name)));
+    header.extend(info.outputs.iter().map(|c| c.name.to_owned()));
     header.extend(
         info.holonomic
             .iter()
@@ -428,6 +475,11 @@ pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), Cl
         let mut rec: Vec<String> = vec![tr.t[i].to_string()];
         rec.extend(tr.q(i).iter().map(f64::to_string));
         rec.extend(tr.qd(i).iter().map(f64::to_string));
+        rec.extend(
+            outputs::values(model, tr.t[i], tr.q(i), tr.qd(i))
+                .iter()
+                .map(f64::to_string),
+        );
         rec.extend(tr.lambda(i).iter().map(f64::to_string));
         rec.push(tr.position_violation[i].to_string());
         rec.push(tr.velocity_violation[i].to_string());

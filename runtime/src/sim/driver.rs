@@ -43,8 +43,12 @@ const MAX_GRID_ROWS: f64 = (1_u64 << 26) as f64;
 /// The output times in $(t_0, t_\text{end}]$.
 fn output_times(output: &Output, t0: f64, t_end: f64) -> Result<Vec<f64>, SimErrorKind> {
     let bad = |value| SimErrorKind::InvalidTimes { t0, t_end, value };
-    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+    if !(t0.is_finite() && t_end.is_finite() && t_end >= t0) {
         return Err(bad(t_end));
+    }
+    if t_end == t0 {
+        // A run of zero span: assembly and the initial row only.
+        return Ok(Vec::new());
     }
     let span = t_end - t0;
     match output {
@@ -84,6 +88,7 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     started: Instant,
     y: &'a mut [f64],
     overridden: Vec<crate::OverriddenVelocity>,
+    repartition_times: Vec<f64>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -171,6 +176,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             monitors: self.monitors,
             redundant_constraints: self.sys.point.redundant.clone(),
             overridden_velocities: self.overridden.clone(),
+            repartition_times: self.repartition_times.clone(),
         }
     }
 
@@ -213,6 +219,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
             overridden_velocities: Vec::new(),
+            repartition_times: Vec::new(),
         }),
     };
     let times = output_times(&sim.output, t0, t_end).map_err(empty)?;
@@ -293,9 +300,13 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         started,
         y: &mut y,
         overridden,
+        repartition_times: Vec::new(),
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
+    }
+    if t_end == t0 {
+        return Ok(rec.run(None));
     }
 
     // Integrator.
@@ -352,6 +363,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 steps: sim.max_steps
             });
         }
+        let partitions = rec.sys.point.kin.repartitions();
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
@@ -374,6 +386,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Correction::Changed => check!(stepper.set_state(rec.y).map_err(ode)),
         }
         check!(rec.sys.accept(t));
+        if rec.sys.point.kin.repartitions() > partitions {
+            rec.repartition_times.push(t);
+        }
         // Its row (or its monitors), then the rows of the output times the step
         // passed, which overwrite the full state.
         if steps_mode {

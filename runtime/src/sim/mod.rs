@@ -416,7 +416,8 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
         self
     }
 
-    /// Simulates from the start time to `t_end`.
+    /// Simulates from the start time to `t_end`. With `t_end` equal to the start time
+    /// the run is the assembled initial state: one row, no step.
     ///
     /// # Errors
     /// A [`SimError`] with the cause and the rows computed before it.

@@ -207,6 +207,9 @@ pub struct Run {
     /// Declared initial velocities that assembly had to change (see
     /// [`Kinematics::assemble_declared`](crate::Kinematics::assemble_declared)).
     pub overridden_velocities: Vec<crate::OverriddenVelocity>,
+    /// The times of the accepted steps at which the partition was chosen anew (one per
+    /// re-partition counted in [`Stats::repartitions`] after the start).
+    pub repartition_times: Vec<f64>,
 }
 
 impl Run {

@@ -2,7 +2,9 @@
 //! free body (math-spec V12), and every joint type against finite differences.
 
 mod joints;
+mod masses;
 mod models;
+mod poses;
 
 use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff::{Mechanism, MechanismExt};

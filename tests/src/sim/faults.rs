@@ -240,3 +240,17 @@ fn a_first_step_the_time_cannot_resolve_is_raised() {
     }
     assert!(pfaff::sim::min_step(0.0, 7.0) > 10.0 * f64::EPSILON * 7.0);
 }
+
+#[test]
+fn a_zero_span_is_the_assembled_initial_state() {
+    // `run(t0)` assembles and records the start only; the pendulum from x = 1, y = 0
+    // at rest hangs from a horizontal link: λ = 0 (no tension at rest, gravity
+    // perpendicular to the link).
+    let model = pendulum::Model::default();
+    let run = Simulation::new(&model).output_every(0.1).run(0.0).unwrap();
+    assert_eq!(run.trajectory.len(), 1);
+    assert_eq!(run.stats.steps, 0);
+    assert_eq!(run.trajectory.t[0], 0.0);
+    assert_eq!(run.trajectory.q(0), &[1.0, 0.0]);
+    assert!(run.trajectory.lambda(0)[0].abs() < 1e-15);
+}

@@ -47,12 +47,14 @@ pub struct PointOut {
     pub position: Vec<ExprId>,
 }
 
-/// A body: its name and frame.
+/// A body: its name, frame and mass.
 #[derive(Debug)]
 pub struct BodyOut {
     pub name: String,
     pub docs: String,
     pub frame: u32,
+    /// The mass expression (parameters), for `body_masses`.
+    pub mass: ExprId,
 }
 
 /// A joint with its rows (indices among the body level's own rows).
@@ -632,6 +634,7 @@ impl<'a> Builder<'_, 'a> {
             name: d.name.to_string(),
             docs: d.docs.clone(),
             frame: idx(k),
+            mass,
         });
         Some(())
     }

@@ -18,6 +18,7 @@
 
 pub mod bodies;
 mod checks;
+pub mod contacts;
 pub mod free_motion;
 pub mod linear;
 
@@ -90,6 +91,8 @@ pub struct Derived {
     pub outputs: Vec<(String, String, ExprId)>,
     /// The linearization Jacobian, for `#[mechanism(linearize)]`.
     pub linear: Option<linear::Linear>,
+    /// Contacts (`#[contact(e)]` gap functions) and their normal Jacobian.
+    pub contacts: contacts::Contacts,
 }
 
 fn idx(i: usize) -> u32 {
@@ -202,6 +205,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         .iter()
         .map(|f| user_row(&mut tr, f, Context::Nonholonomic))
         .collect();
+    let contact_rows = contacts::translate(&mut tr, model);
     drop(tr);
     let mut body_level = body_level;
     let (mut kinetic, mut potential) = (kinetic, potential);
@@ -471,7 +475,9 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     for (name, docs, e) in outputs {
         outs.push((name, docs, e?));
     }
+    let contacts = contacts::derive(cx, model, g, contact_rows, &param_defaults, checking)?;
     let mut derived = Derived {
+        contacts,
         holonomic_names,
         nonholonomic_names,
         bodies: body_level,

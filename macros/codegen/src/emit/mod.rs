@@ -5,6 +5,7 @@
 //! impl. A function whose outputs are all identically zero for the model is not emitted
 //! (the trait's default fills zeros). Runtime paths go through `::pfaff::__private`.
 
+mod contacts;
 pub mod expr;
 
 use std::collections::HashSet;
@@ -240,6 +241,31 @@ fn any_nonzero(g: &Graph, ids: &[ExprId]) -> bool {
     ids.iter().any(|&e| !g.is_zero(e))
 }
 
+/// `core::f64::consts::NAME` for a parameter default that is exactly one of them (a
+/// literal would trip clippy's `approx_constant` in the user's crate).
+fn named_constant(v: f64) -> Option<TokenStream> {
+    use std::f64::consts as c;
+    let table: [(f64, &str); 8] = [
+        (c::PI, "PI"),
+        (c::TAU, "TAU"),
+        (c::E, "E"),
+        (c::FRAC_PI_2, "FRAC_PI_2"),
+        (c::FRAC_PI_3, "FRAC_PI_3"),
+        (c::FRAC_PI_4, "FRAC_PI_4"),
+        (c::FRAC_PI_6, "FRAC_PI_6"),
+        (c::SQRT_2, "SQRT_2"),
+    ];
+    let (sign, a) = if v < 0.0 {
+        (quote!(-), -v)
+    } else {
+        (quote!(), v)
+    };
+    table.iter().find(|(x, _)| *x == a).map(|(_, name)| {
+        let name = Ident::new(name, Span::call_site());
+        quote!(#sign ::core::f64::consts::#name)
+    })
+}
+
 /// `#[doc]` attributes for a doc text, one per line with the leading space that `///`
 /// comments have, so formatted output reads `/// text`.
 fn doc_attr(docs: &str) -> TokenStream {
@@ -261,7 +287,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     let pdefaults: Vec<TokenStream> = d
         .param_defaults
         .iter()
-        .map(|&v| expr::literal(v).0)
+        .map(|&v| named_constant(v).unwrap_or_else(|| expr::literal(v).0))
         .collect();
     let param_count = model.params.len();
     let param_idx: Vec<Literal> = (0..param_count).map(Literal::usize_unsuffixed).collect();
@@ -301,6 +327,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
 
     let mut fns = TokenStream::new();
     let _ = body_level(g, &names, d, &mut fns);
+    let contact_info = contacts::contacts(g, &names, d, &mut fns);
     if !d.outputs.is_empty() {
         let roots: Vec<ExprId> = d.outputs.iter().map(|o| o.2).collect();
         fns.extend(vector_fn(g, &names, "outputs", &roots, true));
@@ -471,8 +498,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 nonholonomic_homogeneous: #homogeneous,
                 conservative: #conservative,
                 outputs: #outputs,
-                contacts: &[],
-                contact_pattern: &[],
+                #contact_info
                 data: &[],
                 linearization: #linearization,
                 #structure
@@ -638,6 +664,10 @@ fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream)
             &b.point_roots,
             false,
         ));
+    }
+    if !b.bodies.is_empty() {
+        let masses: Vec<ExprId> = b.bodies.iter().map(|b| b.mass).collect();
+        fns.extend(vector_fn(g, names, "body_masses", &masses, false));
     }
     quote! {
         frames: &[#(#frames),*],

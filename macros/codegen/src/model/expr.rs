@@ -34,6 +34,8 @@ pub enum Context {
     Kinematics,
     /// A named output (velocities allowed).
     Output,
+    /// A contact's gap function (coordinates and time, no velocities).
+    Contact,
 }
 
 impl Context {
@@ -51,6 +53,7 @@ impl Context {
             Context::Definition => "a definition",
             Context::Kinematics => "a frame, point, body or holonomic joint",
             Context::Output => "an output",
+            Context::Contact => "a contact gap",
         }
     }
     fn allows_velocity(self) -> bool {

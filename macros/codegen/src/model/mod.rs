@@ -51,6 +51,9 @@ pub struct Model {
     pub definitions: Vec<FnItem>,
     /// `#[output]` functions, in declaration order.
     pub outputs: Vec<FnItem>,
+    /// `#[contact(e)]` gap functions with the index of the restitution parameter `e`,
+    /// in declaration order.
+    pub contacts: Vec<(u32, FnItem)>,
     /// Body-level declarations (frames, points, bodies, joints, force elements), in
     /// declaration order.
     pub decls: Vec<Decl>,
@@ -117,6 +120,7 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         nonholonomic: Vec::new(),
         definitions: Vec::new(),
         outputs: Vec::new(),
+        contacts: Vec::new(),
         decls: Vec::new(),
         linearize: ast.linearize,
     };
@@ -197,7 +201,7 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
                         model.outputs.push(f);
                         continue;
                     }
-                    Role::Force(_) => {
+                    Role::Force(_) | Role::Contact(_) => {
                         pending_forces.push(f);
                         continue;
                     }
@@ -207,8 +211,31 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         }
     }
     for f in pending_forces {
+        if let Role::Contact(e) = &f.role {
+            match model.param_index(&e.to_string()) {
+                Some(i) => model.contacts.push((i, f)),
+                None => {
+                    let names = model
+                        .params
+                        .iter()
+                        .map(|p| p.name.to_string())
+                        .collect::<Vec<_>>();
+                    let hint = suggest(&e.to_string(), names.iter().map(String::as_str))
+                        .map(|s| format!("; did you mean `{s}`?"))
+                        .unwrap_or_default();
+                    cx.error_spanned_by(
+                        e,
+                        format!(
+                            "`#[contact({e})]` names no parameter: the coefficient of \
+                             restitution is a parameter (`const {e}: f64 = 0.5;`){hint}"
+                        ),
+                    );
+                }
+            }
+            continue;
+        }
         let Role::Force(target) = &f.role else {
-            unreachable!("only forces are pending")
+            unreachable!("only forces and contacts are pending")
         };
         match model.coord_index(&target.to_string()) {
             Some(i) => model.forces.push((i, f)),

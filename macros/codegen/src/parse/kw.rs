@@ -9,6 +9,7 @@ pub const POTENTIAL_ENERGY: &str = "potential_energy";
 pub const MASS_MATRIX: &str = "mass_matrix";
 pub const COORDINATE: &str = "Coordinate";
 pub const OUTPUT: &str = "output";
+pub const CONTACT: &str = "contact";
 pub const GROUND: &str = "ground";
 /// The types of `static` declarations of the body level.
 pub const FRAME: &str = "Frame";

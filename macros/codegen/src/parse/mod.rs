@@ -93,6 +93,9 @@ pub enum Role {
     Definition,
     /// `#[output]`: a named scalar output.
     Output,
+    /// `#[contact(e)]`: a gap function of `q` and `t` with the parameter `e` as its
+    /// coefficient of restitution.
+    Contact(syn::Ident),
 }
 
 /// Parses the attribute arguments and the module.
@@ -344,18 +347,33 @@ fn parse_fn(cx: &Ctxt, f: syn::ItemFn) -> Option<FnItem> {
                     continue;
                 }
             }
+        } else if path.is_ident(kw::CONTACT) {
+            match attr.parse_args::<syn::Ident>() {
+                Ok(e) => Role::Contact(e),
+                Err(_) => {
+                    cx.error_spanned_by(
+                        attr,
+                        "expected `#[contact(e)]`, with `e` the parameter holding the \
+                         coefficient of restitution",
+                    );
+                    continue;
+                }
+            }
         } else {
             cx.error_spanned_by(
                 attr,
                 format!(
                     "unknown attribute `#[{}]`, expected `#[holonomic]`, `#[nonholonomic]`, \
-                     `#[force(coordinate)]`, `#[virtual_work]` or `#[output]`",
+                     `#[force(coordinate)]`, `#[virtual_work]`, `#[output]` or \
+                     `#[contact(restitution)]`",
                     path.to_token_stream()
                 ),
             );
             continue;
         };
-        if !matches!(attr.meta, syn::Meta::Path(_)) && !matches!(r, Role::Force(_)) {
+        if !matches!(attr.meta, syn::Meta::Path(_))
+            && !matches!(r, Role::Force(_) | Role::Contact(_))
+        {
             cx.error_spanned_by(
                 attr,
                 format!("`#[{}]` takes no arguments", path.to_token_stream()),
