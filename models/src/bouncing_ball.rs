@@ -42,6 +42,18 @@ pub mod bouncing_ball {
         0.5 * pull_rate * ((t - pull_start) + (t - pull_start).abs())
     }
 
+    /// The ball as drawn: a disc resting on its lowest point, which is at height `y`.
+    static ball: Drawing = Disc {
+        center: [0.0, y + 0.05 * h],
+        radius: 0.05 * h,
+        color: "#c0392b",
+    };
+    /// The ground as drawn.
+    static ground_line: Drawing = Ground {
+        at: [0.0, 0.0],
+        normal: [0.0, 1.0],
+    };
+
     /// The ground below the ball: its height.
     #[contact(e)]
     fn floor() -> f64 {

@@ -16,7 +16,8 @@
 //! - [`Dynamics`]: accelerations and multipliers from the augmented system, dense or
 //!   sparse, with minimum-norm multipliers for redundant constraints.
 //! - [`ReactionAnalysis`]: multipliers and generalized constraint forces per named
-//!   constraint ([`Reactions`]), at a state or along a trajectory.
+//!   constraint ([`Reactions`]), at a state or along a trajectory; per joint, the force
+//!   and torque it transmits ([`JointReactions`]).
 //! - [`FreeMotion`]: the explicit multiplier formula and free-motion analysis of the
 //!   second seed paper, with the inverse problems ([`free_motion`]).
 //! - [`ode`]: integrators (RK4, DOPRI5, DOP853, variable-order Adams) over any
@@ -43,6 +44,7 @@ mod error;
 mod ext;
 pub mod free_motion;
 mod impact;
+mod joint_reactions;
 mod kinematics;
 mod linalg;
 mod linearize;
@@ -71,6 +73,7 @@ pub use free_motion::{
     AppliedForces, FreeMotion, FreeMotionError, FreeMotionParams, FreeMotionPoint, FreeMotionReport,
 };
 pub use impact::{Impact, ImpactError, ImpactSolver};
+pub use joint_reactions::{JointReaction, JointReactions, Wrench};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
     linearize, linearize_with, Eigenvalue, Linearization, LinearizeError, LinearizeMethod,

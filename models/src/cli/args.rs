@@ -172,7 +172,12 @@ pub struct SimulateArgs {
     /// violations against time.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// Number of output intervals for --csv and --plot.
+    /// Write one self-contained HTML file that plays the run (no network needed; the
+    /// trajectory is embedded in the JSON format of docs/trajectory-format.md).
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<PathBuf>,
+    /// Number of output intervals for --csv and --plot (--animate uses at least its
+    /// display rate).
     #[arg(long, value_name = "N", default_value_t = 500)]
     pub samples: usize,
     /// Print one JSON object on stdout instead of the summary.

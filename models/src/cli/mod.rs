@@ -2,6 +2,7 @@
 //! mapping of errors to one line on stderr and an exit code (0 success, 1 a failed
 //! computation or I/O, 2 bad input).
 
+mod animate;
 mod args;
 mod error;
 mod linearize;
@@ -40,6 +41,7 @@ fn default_scene() -> SimulateArgs {
         },
         csv: None,
         plot: Some("pfaff-andrews.svg".into()),
+        animate: None,
         samples: 500,
         json: false,
         repeat: 1,

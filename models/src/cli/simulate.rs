@@ -13,7 +13,7 @@ use serde_json::{json, Map, Value};
 use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
 use super::error::{failed, usage, CliError};
 use super::scene::Scene;
-use super::{outputs, plot, setup};
+use super::{animate, outputs, plot, setup};
 
 /// A validated simulation request.
 pub struct Request<'a> {
@@ -174,7 +174,12 @@ fn run_once(
         sim = sim.initial_step(h);
     }
     sim = if dense && t_end > 0.0 {
-        sim.output_every(t_end / req.args.samples as f64)
+        let samples = if req.args.animate.is_some() {
+            animate::grid(req.args.samples, t_end)
+        } else {
+            req.args.samples
+        };
+        sim.output_every(t_end / samples as f64)
     } else if !model.info().outputs.is_empty() {
         // The range of the outputs along the run is taken over the recorded rows.
         sim.output_steps()
@@ -496,7 +501,7 @@ pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
     let model = setup::build(entry, &args.state.set)?;
     let scene = Scene::of(entry.name);
     let req = request(args, &scene)?;
-    let dense = args.csv.is_some() || args.plot.is_some();
+    let dense = args.csv.is_some() || args.plot.is_some() || args.animate.is_some();
     let out = run(model.as_ref(), &req, dense)?;
     report(model.as_ref(), &req, &scene, &out)
 }
@@ -515,6 +520,9 @@ pub fn report(
     }
     if let (Some(path), Ok(())) = (&req.args.plot, &files) {
         files = plot::trajectory(model, &out.run, path);
+    }
+    if let (Some(path), Ok(())) = (&req.args.animate, &files) {
+        files = animate::write(model, &out.run, animation_meta(req, out), path);
     }
     let files = files.map_err(|e| e.kind("io"));
     let result = match (&out.error, files) {
@@ -547,6 +555,25 @@ pub fn report(
         if let Some(path) = &req.args.plot {
             println!("plot         {}", path.display());
         }
+        if let Some(path) = &req.args.animate {
+            println!("animation    {}", path.display());
+        }
     }
     result
+}
+
+/// How the run was made, for the `run` object of the animation's trajectory.
+fn animation_meta(req: &Request<'_>, out: &Outcome) -> Map<String, Value> {
+    let mut m = Map::new();
+    m.insert("formulation".into(), json!(req.formulation.name()));
+    m.insert("integrator".into(), json!(req.method.name()));
+    m.insert("rtol".into(), json!(req.args.rtol));
+    m.insert("atol".into(), json!(req.args.atol));
+    m.insert("t_end".into(), json!(req.t_end));
+    m.insert("steps".into(), json!(out.run.stats.steps));
+    m.insert("repartitions".into(), json!(out.run.stats.repartitions));
+    if let Some(kind) = &out.error {
+        m.insert("error".into(), json!(kind.to_string()));
+    }
+    m
 }

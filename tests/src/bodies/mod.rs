@@ -1,10 +1,12 @@
 //! The body level of `#[mechanism]`: agreement with hand-written models, the Euler-parameter
 //! free body (math-spec V12), and every joint type against finite differences.
 
+mod drawing;
 mod joints;
 mod masses;
 mod models;
 mod poses;
+mod reactions;
 
 use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff::{Mechanism, MechanismExt};

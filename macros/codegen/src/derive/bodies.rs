@@ -19,6 +19,7 @@ use proc_macro2::Span;
 use quote::ToTokens;
 use syn::spanned::Spanned;
 
+use super::drawing::{Attachment, DrawingOut, UserShape, DRAWING_KINDS};
 use super::Row;
 use crate::ctxt::{suggest, Ctxt};
 use crate::model::expr::{Context, Translator};
@@ -89,6 +90,8 @@ pub struct BodyLevel {
     pub poses: Vec<ExprId>,
     /// Per point, its global position (3; `z = 0` in planar models).
     pub point_roots: Vec<ExprId>,
+    /// How the model is drawn.
+    pub drawing: DrawingOut,
 }
 
 fn idx(i: usize) -> u32 {
@@ -250,6 +253,8 @@ struct Builder<'t, 'a> {
     /// `(mass, centre of mass)` of each body, for gravity.
     masses: Vec<(ExprId, Vec<ExprId>)>,
     gravity: Option<(Vec<ExprId>, Span)>,
+    attachments: Vec<Attachment>,
+    shapes: Vec<UserShape>,
 }
 
 /// Expands the body-level declarations of the model translated by `tr`.
@@ -278,11 +283,14 @@ pub fn expand<'a>(
             has_applied: false,
             poses: Vec::new(),
             point_roots: Vec::new(),
+            drawing: DrawingOut::default(),
         },
         kinetic: Vec::new(),
         potential: Vec::new(),
         masses: Vec::new(),
         gravity: None,
+        attachments: Vec::new(),
+        shapes: Vec::new(),
     };
     let mut ok = true;
     for d in decls {
@@ -292,6 +300,7 @@ pub fn expand<'a>(
             DeclKind::Point => b.point(d),
             DeclKind::Joint => b.joint(d),
             DeclKind::Force => b.force(d),
+            DeclKind::Drawing => b.drawing(d),
         };
         ok &= done.is_some();
         if done.is_none() && matches!(d.kind, DeclKind::Frame | DeclKind::Body) {
@@ -346,6 +355,25 @@ pub fn expand<'a>(
             b.out.point_roots.push(zero);
         }
     }
+    let origins: Vec<Vec<ExprId>> = b
+        .out
+        .frames
+        .iter()
+        .map(|f| f.value.origin.clone())
+        .collect();
+    let bodies: Vec<(String, u32)> = b
+        .out
+        .bodies
+        .iter()
+        .map(|x| (x.name.clone(), x.frame))
+        .collect();
+    let points: Vec<(String, u32, Vec<ExprId>)> = b
+        .out
+        .points
+        .iter()
+        .map(|p| (p.name.clone(), p.frame, p.position.clone()))
+        .collect();
+    b.out.drawing = super::drawing::build(g, &origins, &bodies, &points, &b.attachments, &b.shapes);
     b.out.kinetic = g.add(std::mem::take(&mut b.kinetic));
     b.out.potential = g.add(std::mem::take(&mut b.potential));
     Some(b.out)
@@ -887,6 +915,13 @@ impl<'a> Builder<'_, 'a> {
                 let nn = rot(self, &fa, &n);
                 let c = dot(self.g(), &sep, &nn);
                 h.push(("normal", c));
+                if b.is_none() {
+                    self.attachments.push(Attachment::Guide {
+                        name: d.name.to_string(),
+                        point: pb.clone(),
+                        normal: nn.clone(),
+                    });
+                }
                 let r = relative_angle(self)?;
                 h.push(("angle", r));
                 "PlanarPrismatic"
@@ -959,6 +994,7 @@ impl<'a> Builder<'_, 'a> {
                 let radius = self.scalar(fl.get("radius")?, Context::Kinematics)?;
                 let center = self.at(&fl, "center", 3)?;
                 let c = fa.point(self.g(), &center);
+                let wheel_frame = a;
                 let a = rot(self, &fa, &u);
                 // Direction from the centre to the contact point: minus the part of `up`
                 // normal to the wheel's axis, normalized.
@@ -972,6 +1008,17 @@ impl<'a> Builder<'_, 'a> {
                 let down = scale_v(self.g(), s, &w);
                 let p = add_v(self.g(), &c, &down);
                 h.push(("contact", dot(self.g(), &p, &up.0)));
+                if let Some(frame) = wheel_frame {
+                    self.attachments.push(Attachment::Wheel {
+                        name: d.name.to_string(),
+                        frame: idx(frame),
+                        center: c.clone(),
+                        axis: a.clone(),
+                        radius,
+                        contact: p.clone(),
+                        up: up.0.clone(),
+                    });
+                }
                 let vc: Vec<ExprId> = c
                     .iter()
                     .map(|&x| time_derivative(self.g(), nq, x))
@@ -997,6 +1044,20 @@ impl<'a> Builder<'_, 'a> {
                 return None;
             }
         };
+        match (variant, a) {
+            ("ZeroVelocity", Some(frame)) => self.attachments.push(Attachment::Edge {
+                name: d.name.to_string(),
+                frame: idx(frame),
+                point: pa.clone(),
+            }),
+            ("RollingWheel", _) => {}
+            _ => self.attachments.push(Attachment::Joint {
+                name: d.name.to_string(),
+                kind: variant,
+                frames: [a.map(idx), b.map(idx)],
+                points: [pa.clone(), pb.clone()],
+            }),
+        }
         let hr = self.push_rows(d, h, false);
         let nr = self.push_rows(d, nh, true);
         self.out.joints.push(JointOut {
@@ -1006,6 +1067,104 @@ impl<'a> Builder<'_, 'a> {
             frames: [a.map(idx), b.map(idx)],
             holonomic: hr,
             nonholonomic: nr,
+        });
+        Some(())
+    }
+
+    /// A vector field of a `Drawing` item, in the coordinates of `frame` (global when
+    /// `None`), returned in global coordinates; `direction`: rotated only.
+    fn draw_vector(
+        &mut self,
+        e: &syn::Expr,
+        frame: Option<usize>,
+        dim: &mut Option<usize>,
+        direction: bool,
+    ) -> Option<Vec<ExprId>> {
+        let v = match self.tr.field_value(e, Context::Kinematics)? {
+            Value::Vector(v) if matches!(v.len(), 2 | 3) && dim.is_none_or(|d| d == v.len()) => v,
+            other => {
+                let want = dim.map_or("a 2- or 3-vector".to_owned(), |d| format!("a {d}-vector"));
+                self.cx
+                    .error_spanned_by(e, format!("expected {want}; this is {}", other.describe()));
+                return None;
+            }
+        };
+        *dim = Some(v.len());
+        let fv = self.tr.frame_value(frame, v.len());
+        Some(if direction {
+            mat_vec(self.g(), v.len(), &fv.rotation, &v)
+        } else {
+            fv.point(self.g(), &v)
+        })
+    }
+
+    /// `static name: Drawing = Link { points: [..], frame?, color? }` and the other
+    /// shapes of [`DRAWING_KINDS`].
+    fn drawing(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, DRAWING_KINDS, "shape")?;
+        let kind = super::drawing::shape_kind(&fl.kind)?;
+        let frame = match fl.get("frame") {
+            Some(e) => self.frame_of(e)?,
+            None => None,
+        };
+        let mut dim = frame.map(|k| self.tr.frames[k].dim);
+        let mut points = Vec::new();
+        match fl.get("points") {
+            Some(e) => {
+                let syn::Expr::Array(list) = e else {
+                    self.cx.error_spanned_by(
+                        e,
+                        "expected an array of points, e.g. `[[0.0, 0.0], [x, y]]`",
+                    );
+                    return None;
+                };
+                if list.elems.is_empty() || (kind == "Spring" && list.elems.len() != 2) {
+                    let want = if kind == "Spring" {
+                        "two points"
+                    } else {
+                        "at least one point"
+                    };
+                    self.cx
+                        .error_spanned_by(e, format!("a `{}` takes {want}", fl.kind));
+                    return None;
+                }
+                for p in &list.elems {
+                    points.push(self.draw_vector(p, frame, &mut dim, false)?);
+                }
+            }
+            None => {
+                let e = fl.get("center").or_else(|| fl.get("at"))?;
+                points.push(self.draw_vector(e, frame, &mut dim, false)?);
+            }
+        }
+        let normal = match fl.get("normal").or_else(|| fl.get("axis")) {
+            Some(e) => Some(self.draw_vector(e, frame, &mut dim, true)?),
+            None => None,
+        };
+        let radius = match fl.get("radius") {
+            Some(e) => Some(self.scalar(e, Context::Kinematics)?),
+            None => None,
+        };
+        let color = match fl.get("color") {
+            Some(syn::Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Str(s),
+                ..
+            })) => Some(s.value()),
+            Some(e) => {
+                self.cx
+                    .error_spanned_by(e, "a colour is a string literal, e.g. `\"#c0392b\"`");
+                return None;
+            }
+            None => None,
+        };
+        self.shapes.push(UserShape {
+            name: d.name.to_string(),
+            kind,
+            frame: frame.map(idx),
+            points,
+            normal,
+            radius,
+            color,
         });
         Some(())
     }
@@ -1053,6 +1212,11 @@ impl<'a> Builder<'_, 'a> {
                 let at_b = self.at(&fl, "at_b", dim)?;
                 let pa = fa.point(self.g(), &at_a);
                 let pb = fb.point(self.g(), &at_b);
+                self.attachments.push(Attachment::Spring {
+                    name: d.name.to_string(),
+                    frames: [a.map(idx), b.map(idx)],
+                    points: [pa.clone(), pb.clone()],
+                });
                 let sep = sub_v(self.g(), &pa, &pb);
                 let l2 = dot(self.g(), &sep, &sep);
                 let l = self.g().call(Func::Sqrt, l2);

@@ -19,6 +19,7 @@
 pub mod bodies;
 mod checks;
 pub mod contacts;
+pub mod drawing;
 pub mod free_motion;
 pub mod linear;
 

@@ -669,11 +669,61 @@ fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream)
         let masses: Vec<ExprId> = b.bodies.iter().map(|b| b.mass).collect();
         fns.extend(vector_fn(g, names, "body_masses", &masses, false));
     }
+    fns.extend(drawing(g, names, &b.drawing));
     quote! {
         frames: &[#(#frames),*],
         points: &[#(#points),*],
         bodies: &[#(#bodies),*],
         joints: &[#(#joints),*],
+    }
+}
+
+/// The trait methods `drawing` (the static shapes) and `drawing_values` (the points'
+/// global coordinates, then the scalars), when the model has shapes.
+fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut) -> TokenStream {
+    if d.shapes.is_empty() {
+        return TokenStream::new();
+    }
+    let opt = |x: Option<u32>| match x {
+        Some(k) => quote!(::core::option::Option::Some(#k)),
+        None => quote!(::core::option::Option::None),
+    };
+    let points = d.points.iter().map(|p| {
+        let (n, f) = (&p.name, opt(p.frame));
+        quote!(::pfaff::__private::DrawPoint { name: #n, frame: #f })
+    });
+    let shapes = d.shapes.iter().map(|s| {
+        let n = &s.name;
+        let kind = Ident::new(s.kind, Span::call_site());
+        let (f, nrm, r) = (opt(s.frame), opt(s.normal), opt(s.radius));
+        let pts = &s.points;
+        let color = match &s.color {
+            Some(c) => quote!(::core::option::Option::Some(#c)),
+            None => quote!(::core::option::Option::None),
+        };
+        quote!(::pfaff::__private::Shape {
+            name: #n, kind: ::pfaff::__private::ShapeKind::#kind, frame: #f,
+            points: &[#(#pts),*], normal: #nrm, radius: #r, color: #color,
+        })
+    });
+    let scalars = u32::try_from(d.scalars.len()).expect("drawing size fits u32");
+    let mut roots: Vec<ExprId> = d
+        .points
+        .iter()
+        .flat_map(|p| p.value.iter().copied())
+        .collect();
+    roots.extend(d.scalars.iter().copied());
+    let values = vector_fn(g, names, "drawing_values", &roots, false);
+    quote! {
+        fn drawing(&self) -> &'static ::pfaff::__private::Drawing {
+            static DRAWING: ::pfaff::__private::Drawing = ::pfaff::__private::Drawing {
+                points: &[#(#points),*],
+                scalars: #scalars,
+                shapes: &[#(#shapes),*],
+            };
+            &DRAWING
+        }
+        #values
     }
 }
 

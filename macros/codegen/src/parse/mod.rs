@@ -44,7 +44,7 @@ pub enum Item {
     },
     /// A function item with its role.
     Fn(FnItem),
-    /// `static name: Frame|Point|Body|Joint|Force = <constructor>;`, a declaration of
+    /// `static name: Frame|Point|Body|Joint|Force|Drawing = <constructor>;`, a declaration of
     /// the body level.
     Decl(Decl),
 }
@@ -57,6 +57,8 @@ pub enum DeclKind {
     Body,
     Joint,
     Force,
+    /// A shape to draw (`pfaff::Drawing`).
+    Drawing,
 }
 
 /// A body-level declaration: its kind, name and constructor expression.
@@ -195,6 +197,7 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 (kw::BODY, DeclKind::Body),
                 (kw::JOINT, DeclKind::Joint),
                 (kw::FORCE_ELEMENT, DeclKind::Force),
+                (kw::DRAWING, DeclKind::Drawing),
             ]
             .into_iter()
             .find(|(n, _)| is_type(&s.ty, n))
@@ -211,7 +214,7 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 cx.error_spanned_by(
                     &s.ty,
                     "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
-                     a `Point`, a `Body`, a `Joint` or a `Force`",
+                     a `Point`, a `Body`, a `Joint`, a `Force` or a `Drawing`",
                 );
                 return None;
             }
