@@ -10,8 +10,9 @@ use crate::{ctxt, derive, model, parse};
 #[path = "../../../models/src/chain/source.rs"]
 mod chain;
 
-/// The `#[mechanism]` modules of a source file, the attribute removed.
-fn modules(src: &str) -> Vec<(String, TokenStream)> {
+/// The `#[mechanism]` modules of a source file, the attribute removed (its arguments,
+/// e.g. `linearize`, kept with the module).
+fn modules(src: &str) -> Vec<(String, TokenStream, TokenStream)> {
     let file = syn::parse_file(src).expect("model files parse");
     file.items
         .into_iter()
@@ -23,8 +24,12 @@ fn modules(src: &str) -> Vec<(String, TokenStream)> {
                         .last()
                         .is_some_and(|s| s.ident == "mechanism")
                 })?;
+                let args = match &m.attrs[at].meta {
+                    syn::Meta::List(l) => l.tokens.clone(),
+                    _ => TokenStream::new(),
+                };
                 m.attrs.remove(at);
-                Some((m.ident.to_string(), m.into_token_stream()))
+                Some((m.ident.to_string(), args, m.into_token_stream()))
             }
             _ => None,
         })
@@ -32,15 +37,25 @@ fn modules(src: &str) -> Vec<(String, TokenStream)> {
 }
 
 /// The graph's nodes and a dump of the derived quantities.
-fn derive_in(mut g: Graph, src: &TokenStream) -> (Vec<Node>, String) {
+fn derive_in(mut g: Graph, args: &TokenStream, src: &TokenStream) -> (Vec<Node>, String) {
     let cx = ctxt::Ctxt::new();
-    let ast = parse::parse(&cx, TokenStream::new(), src.clone()).expect("the model parses");
+    let ast = parse::parse(&cx, args.clone(), src.clone()).expect("the model parses");
     let m = model::lower(&cx, ast);
     let d = derive::derive(&cx, &m, &mut g).expect("the model derives");
     cx.check().expect("no diagnostics");
     let dump = format!(
-        "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
-        d.mass, d.forces, d.c, d.cq, d.ct, d.gamma_h, d.gm, d.gb, d.gamma_nh, d.applied
+        "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
+        d.mass,
+        d.forces,
+        d.c,
+        d.cq,
+        d.ct,
+        d.gamma_h,
+        d.gm,
+        d.gb,
+        d.gamma_nh,
+        d.applied,
+        d.linear.as_ref().map(|l| &l.entries)
     );
     let nodes = (0..g.len())
         .map(|i| g.node(ExprId::from_index(i)).clone())
@@ -60,9 +75,13 @@ fn every_built_in_model_and_a_chain_derive_as_with_the_full_walk() {
     }
     assert!(sources.len() > 10, "the built-in models were found");
     sources.extend(modules(&chain::chain_source("chain4", 4)));
-    for (name, src) in &sources {
-        let (skip_nodes, skip) = derive_in(Graph::new(), src);
-        let (full_nodes, full) = derive_in(Graph::full_walk(), src);
+    assert!(
+        sources.iter().any(|(_, args, _)| !args.is_empty()),
+        "a model with a generated linearization is among them"
+    );
+    for (name, args, src) in &sources {
+        let (skip_nodes, skip) = derive_in(Graph::new(), args, src);
+        let (full_nodes, full) = derive_in(Graph::full_walk(), args, src);
         assert_eq!(skip, full, "{name}: derived quantities");
         assert_eq!(skip_nodes.len(), full_nodes.len(), "{name}: graph size");
         assert!(skip_nodes == full_nodes, "{name}: graph nodes");
@@ -74,7 +93,7 @@ fn a_chain_has_a_sparse_mass_matrix_and_jacobian() {
     // Seven coordinates per link; a link's kinetic energy involves only its own, so M is
     // block diagonal (7×7 blocks, those of the Euler parameters full 4×4, the masses
     // on the diagonal) and each joint row involves at most two links.
-    let (_, src) = modules(&chain::chain_source("chain5", 5)).remove(0);
+    let (_, _, src) = modules(&chain::chain_source("chain5", 5)).remove(0);
     let cx = ctxt::Ctxt::new();
     let ast = parse::parse(&cx, TokenStream::new(), src).expect("the model parses");
     let m = model::lower(&cx, ast);

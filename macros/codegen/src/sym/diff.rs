@@ -123,7 +123,8 @@ pub fn for_each_partial(
             (Var::Q(_), Var::Q(j))
             | (Var::Qd(_), Var::Qd(j))
             | (Var::Delta(_), Var::Delta(j))
-            | (Var::Param(_), Var::Param(j)) => j,
+            | (Var::Param(_), Var::Param(j))
+            | (Var::Input(_), Var::Input(j)) => j,
             _ => continue,
         };
         if j == 0 || j as usize >= n || var(j) != v {

@@ -55,6 +55,9 @@ pub enum Var {
     Delta(u32),
     /// Model parameter `p_i`.
     Param(u32),
+    /// Entry `i` of a vector the caller passes at run time (the accelerations and
+    /// multipliers at which the linearization Jacobian is evaluated).
+    Input(u32),
 }
 
 /// A node of the DAG.
@@ -101,6 +104,7 @@ impl Deps {
     pub const QD: Deps = Deps(4);
     pub const DELTA: Deps = Deps(8);
     pub const PARAM: Deps = Deps(16);
+    pub const INPUT: Deps = Deps(32);
 
     /// The kind of a variable.
     pub fn of(v: Var) -> Deps {
@@ -110,6 +114,7 @@ impl Deps {
             Var::Qd(_) => Deps::QD,
             Var::Delta(_) => Deps::DELTA,
             Var::Param(_) => Deps::PARAM,
+            Var::Input(_) => Deps::INPUT,
         }
     }
     /// Whether any of the kinds in `other` is present.
