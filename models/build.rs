@@ -11,11 +11,10 @@ mod source;
 fn main() {
     println!("cargo:rerun-if-changed=src/chain/source.rs");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    for (name, n) in [("chain10", 10)] {
-        std::fs::write(
-            out.join(format!("{name}.rs")),
-            source::chain_source(name, n),
-        )
-        .expect("OUT_DIR is writable");
-    }
+    let (name, n) = ("chain10", 10);
+    std::fs::write(
+        out.join(format!("{name}.rs")),
+        source::chain_source(name, n),
+    )
+    .expect("OUT_DIR is writable");
 }
