@@ -47,6 +47,8 @@ mod bicycle_model;
 mod body_impact_model;
 #[path = "bouncing_ball.rs"]
 mod bouncing_ball_model;
+#[path = "bricard.rs"]
+mod bricard_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
 /// The spatial N-link chain's source for any `N` (the template of `chain10`, which the
@@ -92,6 +94,7 @@ pub use andrews_model::andrews;
 pub use bicycle_model::bicycle;
 pub use body_impact_model::{body_impact, two_body_impact};
 pub use bouncing_ball_model::bouncing_ball;
+pub use bricard_model::bricard;
 pub use car_axis_model::car_axis;
 pub use chain_models::chain10;
 pub use falling_rod_model::falling_rod;
@@ -161,6 +164,11 @@ static ALL: &[Entry] = &[
         name: "spatial_four_bar",
         summary: "spatial four-bar (revolute, spherical, universal) with Euler parameters",
         make: || Box::new(spatial_four_bar::Model::default()),
+    },
+    Entry {
+        name: "bricard",
+        summary: "Bricard's overconstrained 6R loop, rank-deficient everywhere (IFToMM A04)",
+        make: || Box::new(bricard::Model::default()),
     },
     Entry {
         name: "andrews",
