@@ -330,6 +330,52 @@ pub fn decimate(times: &[f64], n: usize) -> Vec<usize> {
     out
 }
 
+/// `rows` (increasing) with, for each of `times`, the rows at that time (an impact
+/// records the state before and after at one time) or else the nearest one, so that a
+/// decimated replay shows the moment of each event.
+#[must_use]
+pub fn keep_rows_at(all: &[f64], mut rows: Vec<usize>, times: &[f64]) -> Vec<usize> {
+    if all.is_empty() {
+        return rows;
+    }
+    for &t in times {
+        let i = all.partition_point(|&x| x < t);
+        let mut j = i;
+        while j < all.len() && all[j] == t {
+            rows.push(j);
+            j += 1;
+        }
+        if j == i {
+            let near = match i {
+                0 => 0,
+                _ if i == all.len() => i - 1,
+                _ if all[i] - t < t - all[i - 1] => i,
+                _ => i - 1,
+            };
+            rows.push(near);
+        }
+    }
+    rows.sort_unstable();
+    rows.dedup();
+    rows
+}
+
+/// The events of a run, in time order.
+fn events_of(run: &Run) -> Vec<Event> {
+    let mut events: Vec<Event> = run
+        .repartition_times
+        .iter()
+        .map(|&t| Event {
+            t,
+            kind: "repartition".to_owned(),
+            name: None,
+            detail: None,
+        })
+        .collect();
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    events
+}
+
 /// `x` with `digits` significant digits.
 fn round(x: f64, digits: Option<u32>) -> f64 {
     match digits {
@@ -366,8 +412,17 @@ impl Replay {
     ) -> Replay {
         let info = model.info();
         let tr = &run.trajectory;
+        let events = events_of(run);
         let rows = match (tr.t.first(), tr.t.last()) {
-            (Some(&a), Some(&b)) => decimate(&tr.t, opts.samples(a, b)),
+            (Some(&a), Some(&b)) => {
+                // Many events (a chattering contact) are marks only, not samples.
+                let times: Vec<f64> = if events.len() <= opts.max_samples / 10 {
+                    events.iter().map(|e| e.t).collect()
+                } else {
+                    Vec::new()
+                };
+                keep_rows_at(&tr.t, decimate(&tr.t, opts.samples(a, b)), &times)
+            }
             _ => Vec::new(),
         };
         let r = |x: f64| round(x, opts.digits);
@@ -488,17 +543,6 @@ impl Replay {
                 && draw_points
                     .iter()
                     .any(|p| p.position.chunks_exact(3).any(|v| v[2] != 0.0)));
-        let mut events: Vec<Event> = run
-            .repartition_times
-            .iter()
-            .map(|&t| Event {
-                t,
-                kind: "repartition".to_owned(),
-                name: None,
-                detail: None,
-            })
-            .collect();
-        events.sort_by(|a, b| a.t.total_cmp(&b.t));
         Replay {
             format: FORMAT.to_owned(),
             version: VERSION,
@@ -701,6 +745,18 @@ mod tests {
         assert_eq!(opts.samples(0.0, 1.0), 600);
         assert_eq!(opts.samples(0.0, 10.0), 2400);
         assert_eq!(opts.samples(0.0, 1e6), 6000);
+    }
+
+    #[test]
+    fn event_rows_are_kept() {
+        let times = [0.0, 0.1, 0.2, 0.25, 0.25, 0.3, 0.4];
+        // Both rows at 0.25 (before and after an impact), the nearest row to 0.37.
+        assert_eq!(
+            keep_rows_at(&times, vec![0, 2, 6], &[0.25, 0.37]),
+            vec![0, 2, 3, 4, 6]
+        );
+        assert_eq!(keep_rows_at(&times, vec![0, 6], &[-1.0, 9.0]), vec![0, 6]);
+        assert_eq!(keep_rows_at(&[], vec![], &[1.0]), Vec::<usize>::new());
     }
 
     #[test]
