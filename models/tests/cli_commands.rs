@@ -70,8 +70,10 @@ fn check_keys(v: &Value, with_error: bool) {
     keys.sort_unstable();
     let mut expected = vec![
         "atol",
+        "contact_events",
         "energy",
         "final",
+        "impacts",
         "formulation",
         "integrator",
         "max_violation",
