@@ -168,6 +168,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats.steps = o.steps;
             stats.rejected = o.rejected;
             stats.rhs_evals = o.rhs_evals;
+            stats.jacobians = o.jac_evals;
+            stats.stage_factorizations = o.factorizations;
+            stats.stage_newton_iterations = o.newton_iterations;
             stats.restarts = o.restarts.saturating_sub(1);
         }
         Run {
