@@ -9,7 +9,8 @@
 //! accumulate at $t_\infty = \sqrt{2h/g}\,(1+e)/(1-e)$.
 
 use pfaff::ode::{
-    Adams, Crossing, Dop853, Dopri5, EventLocator, Integrator, OdeOptions, OdeSystem, Radau5, RhsError,
+    Adams, Crossing, Dop853, Dopri5, EventLocator, Integrator, OdeOptions, OdeSystem, Radau5,
+    RhsError,
 };
 
 const G: f64 = 9.81;

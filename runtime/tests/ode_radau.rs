@@ -110,7 +110,12 @@ fn errors_are_proportional_to_the_tolerance() {
             println!(
                 "a = {a:e} tol {tol:.0e}: {at_steps:.2} {:.2} | {} {} {} {} {} {}",
                 dense * tol / (0.1 * tol.powf(2.0 / 3.0)),
-                s.steps, s.rejected, s.rhs_evals, s.jac_evals, s.factorizations, s.newton_iterations
+                s.steps,
+                s.rejected,
+                s.rhs_evals,
+                s.jac_evals,
+                s.factorizations,
+                s.newton_iterations
             );
             // The method controls the local error against the transformed tolerance
             // rtol' = 0.1 tol^(2/3) (radau5.f), chosen so that the global error
@@ -119,9 +124,15 @@ fn errors_are_proportional_to_the_tolerance() {
             // component's error is of the stage order 3, not 5), still below rtol'.
             let rtol_t = 0.1 * tol.powf(2.0 / 3.0);
             if a == 1.0 || tol >= 1e-9 {
-                assert!(at_steps < 10.0, "a = {a}, tol {tol}: scaled error {at_steps}");
+                assert!(
+                    at_steps < 10.0,
+                    "a = {a}, tol {tol}: scaled error {at_steps}"
+                );
             } else {
-                assert!(at_steps < 30.0 && at_steps * tol < rtol_t, "a = {a}, tol {tol}: {at_steps}");
+                assert!(
+                    at_steps < 30.0 && at_steps * tol < rtol_t,
+                    "a = {a}, tol {tol}: {at_steps}"
+                );
             }
             // The collocation polynomial is of order 3 inside the step (order 5 only
             // at its ends): its error follows rtol', not tol.
@@ -155,15 +166,26 @@ fn stiff_problem_costs_explicit_methods_orders_of_magnitude_more_steps() {
         (max_err(ode.y(), t_end), *ode.stats())
     }
     let o = OdeOptions::with_tol(tol);
-    run("radau5", &mut |s| go(Radau5::new(2, o.clone()).unwrap(), s, t_end));
-    run("dopri5", &mut |s| go(Dopri5::new(2, o.clone()).unwrap(), s, t_end));
-    run("dop853", &mut |s| go(Dop853::new(2, o.clone()).unwrap(), s, t_end));
+    run("radau5", &mut |s| {
+        go(Radau5::new(2, o.clone()).unwrap(), s, t_end)
+    });
+    run("dopri5", &mut |s| {
+        go(Dopri5::new(2, o.clone()).unwrap(), s, t_end)
+    });
+    run("dop853", &mut |s| {
+        go(Dop853::new(2, o.clone()).unwrap(), s, t_end)
+    });
     let (radau, explicit) = (rows[0], &rows[1..]);
     assert!(radau.0 < 10.0 * tol, "radau5 error {}", radau.0);
     for (err, s) in explicit {
         assert!(*err < 10.0 * tol);
         // Stability bounds the explicit step by about 3.3/a: some 3e4 steps.
-        assert!(s.steps > 100 * radau.1.steps, "{} against {}", s.steps, radau.1.steps);
+        assert!(
+            s.steps > 100 * radau.1.steps,
+            "{} against {}",
+            s.steps,
+            radau.1.steps
+        );
         assert!(s.rhs_evals > 10 * radau.1.rhs_evals);
     }
 }

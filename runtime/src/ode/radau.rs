@@ -75,28 +75,49 @@ fn coef() -> Coef {
     Coef {
         c1: (4.0 - sq6) / 10.0,
         c2: (4.0 + sq6) / 10.0,
-        dd: [-(13.0 + 7.0 * sq6) / 3.0, (-13.0 + 7.0 * sq6) / 3.0, -1.0 / 3.0],
+        dd: [
+            -(13.0 + 7.0 * sq6) / 3.0,
+            (-13.0 + 7.0 * sq6) / 3.0,
+            -1.0 / 3.0,
+        ],
         u1: 1.0 / u1,
         alph: alph / cno,
         beta: beta / cno,
     }
 }
 
+// The digits of radau5.f, kept as published.
+#[allow(clippy::excessive_precision)]
 const T11: f64 = 9.123_239_487_089_294_279_2e-2;
+#[allow(clippy::excessive_precision)]
 const T12: f64 = -0.141_255_295_020_954_208_43;
+#[allow(clippy::excessive_precision)]
 const T13: f64 = -3.002_919_410_514_742_449_2e-2;
+#[allow(clippy::excessive_precision)]
 const T21: f64 = 0.241_717_932_707_107_018_96;
+#[allow(clippy::excessive_precision)]
 const T22: f64 = 0.204_129_352_293_799_931_99;
+#[allow(clippy::excessive_precision)]
 const T23: f64 = 0.382_942_112_757_261_937_79;
+#[allow(clippy::excessive_precision)]
 const T31: f64 = 0.966_048_182_615_092_936_19;
+#[allow(clippy::excessive_precision)]
 const TI11: f64 = 4.325_579_890_063_155_351;
+#[allow(clippy::excessive_precision)]
 const TI12: f64 = 0.339_199_251_815_809_869_54;
+#[allow(clippy::excessive_precision)]
 const TI13: f64 = 0.541_770_539_935_874_871_19;
+#[allow(clippy::excessive_precision)]
 const TI21: f64 = -4.178_718_591_551_904_727_3;
+#[allow(clippy::excessive_precision)]
 const TI22: f64 = -0.327_682_820_761_062_387_08;
+#[allow(clippy::excessive_precision)]
 const TI23: f64 = 0.476_623_554_500_550_451_96;
+#[allow(clippy::excessive_precision)]
 const TI31: f64 = -0.502_872_634_945_786_875_95;
+#[allow(clippy::excessive_precision)]
 const TI32: f64 = 2.571_926_949_855_605_429_2;
+#[allow(clippy::excessive_precision)]
 const TI33: f64 = -0.596_039_204_828_224_924_97;
 
 /// Radau IIA of order 5 with simplified Newton, a finite-difference Jacobian, error
@@ -220,8 +241,7 @@ impl Radau5 {
 
     fn update_scal(&mut self) {
         for i in 0..self.y.len() {
-            self.scal[i] =
-                self.opts.tol.atol(i) * self.atol_factor + self.rtol * self.y[i].abs();
+            self.scal[i] = self.opts.tol.atol(i) * self.atol_factor + self.rtol * self.y[i].abs();
         }
     }
 
@@ -340,7 +360,13 @@ impl Radau5 {
                 for i in 0..n {
                     self.tmp[i] = self.y[i] + self.z[s][i];
                 }
-                match eval(sys, &mut self.stats, self.t + c * h, &self.tmp, &mut self.z[s]) {
+                match eval(
+                    sys,
+                    &mut self.stats,
+                    self.t + c * h,
+                    &self.tmp,
+                    &mut self.z[s],
+                ) {
                     Ok(()) => {}
                     Err(OdeError::NonFinite {
                         quantity: Quantity::Derivative,
@@ -382,12 +408,16 @@ impl Radau5 {
             }
             if newt > 1 && newt < NIT {
                 let thq = dyno / dynold;
-                self.theta = if newt == 2 { thq } else { (thq * thqold).sqrt() };
+                self.theta = if newt == 2 {
+                    thq
+                } else {
+                    (thq * thqold).sqrt()
+                };
                 thqold = thq;
                 if self.theta < 0.99 {
                     self.faccon = self.theta / (1.0 - self.theta);
-                    let dyth = self.faccon * dyno * self.theta.powi((NIT - 1 - newt) as i32)
-                        / fnewt;
+                    let dyth =
+                        self.faccon * dyno * self.theta.powi((NIT - 1 - newt) as i32) / fnewt;
                     if dyth >= 1.0 {
                         let qnewt = dyth.clamp(1e-4, 20.0);
                         let e = -1.0 / (4.0 + f64::from(NIT) - 1.0 - f64::from(newt));
