@@ -42,3 +42,29 @@ fn show_lists_contacts() {
     let text = stdout(&pfaff(&["show", "pendulum"]));
     assert!(text.contains("contacts (0):"), "{text}");
 }
+
+/// `simulate` reports the impacts: the summary lists them with the rest, `--json` has
+/// `impacts` (time, contact, impulse, energy lost) and `contact_events`. The first
+/// impact of the ball dropped from h = 1 is at √(2h/g) with the impulse (1 + e) m √(2gh).
+#[test]
+fn simulate_reports_impacts() {
+    let out = pfaff(&["simulate", "bouncing_ball", "--t-end", "2", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("json");
+    let impacts = v["impacts"].as_array().expect("impacts");
+    assert!(impacts.len() > 10, "{}", impacts.len());
+    let first = &impacts[0];
+    assert_eq!(first["contact"], "floor");
+    let t = first["t"].as_f64().unwrap();
+    assert!((t - (2.0_f64 / 9.81).sqrt()).abs() < 1e-6, "{t}");
+    let p = first["impulse"].as_f64().unwrap();
+    assert!((p - 1.5 * (2.0_f64 * 9.81).sqrt()).abs() < 1e-5, "{p}");
+    assert!(first["energy_lost"].as_f64().unwrap() > 0.0);
+    let events = v["contact_events"].as_array().expect("events");
+    assert_eq!(events[0]["kind"], "rest");
+    let text = stdout(&pfaff(&["simulate", "bouncing_ball", "--t-end", "2"]));
+    assert!(text.contains("impacts      "), "{text}");
+    assert!(text.contains("floor comes to rest"), "{text}");
+    let text = stdout(&pfaff(&["simulate", "pendulum"]));
+    assert!(!text.contains("impacts"), "{text}");
+}

@@ -38,6 +38,9 @@
 //! [`ImpactSolver`] holds its scratch: after [`ImpactSolver::new`], a solve allocates
 //! only the [`Impact`] it returns.
 
+// Index loops mirror the block structure of the augmented matrix.
+#![allow(clippy::needless_range_loop)]
+
 use crate::linalg::dense::DenseLu;
 use crate::workspace::{check_finite, scatter_row_major, EvalError, Quantity, Workspace};
 use crate::{
@@ -200,6 +203,7 @@ pub struct ImpactSolver {
     d: Vec<f64>,
     rate: Vec<f64>,
     gaps: Vec<f64>,
+    gamma: Vec<f64>,
     lu: DenseLu,
     x: Vec<f64>,
     /// Rows of $[J; D]$ for the rank test, and the orthonormal basis.
@@ -237,6 +241,7 @@ impl ImpactSolver {
             d: vec![0.0; nc * n],
             rate: vec![0.0; nc],
             gaps: vec![0.0; nc],
+            gamma: vec![0.0; nc],
             lu: DenseLu::new(dim, 1),
             x: vec![0.0; dim],
             rows: vec![0.0; (m + nc) * n],
@@ -633,6 +638,180 @@ impl ImpactSolver {
         }
         solve_dense(&mut jdt, m, &mut rhs);
         self.finish(mech, t, q, qd, qd_after, contacts, impulses, rhs, vn)
+    }
+
+    /// Factors the augmented matrix of (E41) at $(t, q)$ with the rows of the contacts
+    /// in `active` (identity rows for the others); allocation-free except on failure.
+    fn factor_active<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        active: &[bool],
+    ) -> Result<(), ImpactError> {
+        let info = self.info;
+        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
+        let dim = n + m + nc;
+        mech.mass_matrix(t, q, &mut self.mass_values);
+        check_finite(Quantity::MassMatrix, t, &self.mass_values)?;
+        scatter_row_major(info.mass_pattern, &self.mass_values, n, &mut self.mass);
+        self.ws.eval_jacobian(mech, t, q)?;
+        self.eval_contacts(mech, t, q)?;
+        {
+            let jac = self.ws.jacobian();
+            let mut a = self.lu.matrix_mut();
+            for i in 0..dim {
+                for j in 0..dim {
+                    a[(i, j)] = 0.0;
+                }
+            }
+            for i in 0..n {
+                for j in 0..n {
+                    a[(i, j)] = self.mass[i * n + j];
+                }
+            }
+            for r in 0..m {
+                for j in 0..n {
+                    let v = jac[r * n + j];
+                    a[(n + r, j)] = v;
+                    a[(j, n + r)] = v;
+                }
+            }
+            for c in 0..nc {
+                if active[c] {
+                    for j in 0..n {
+                        let v = self.d[c * n + j];
+                        a[(n + m + c, j)] = v;
+                        a[(j, n + m + c)] = -v;
+                    }
+                } else {
+                    a[(n + m + c, n + m + c)] = 1.0;
+                }
+            }
+        }
+        let ratio = self.lu.factor().ratio();
+        if ratio < MASS_TOLERANCE {
+            let contacts: Vec<usize> = (0..nc).filter(|&c| active[c]).collect();
+            self.rank_check(t, &contacts)?;
+            return Err(ImpactError::SingularMass { t, ratio });
+        }
+        Ok(())
+    }
+
+    /// Resting contact: corrects the accelerations `qdd` and multipliers `lambda` of
+    /// the model's equations at $(t, q, \dot q)$ so that the contacts in `active` stay
+    /// closed ($D\ddot q = \gamma_c$), and writes their normal forces $\nu$ into `nu`
+    /// (positive: compressive; the generalized contact force is $D^\mathsf{T}\nu$).
+    /// The correction is the least-action change of the accelerations:
+    /// $[M\ J^\mathsf{T}\ {-D^\mathsf{T}};\ J\ 0\ 0;\ D\ 0\ 0]
+    /// [\Delta\ddot q; \Delta\lambda; \nu] = [0; 0; \gamma_c - D\ddot q]$.
+    /// Allocation-free.
+    ///
+    /// # Errors
+    /// A failed evaluation, or a singular matrix.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rest_correction<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+        active: &[bool],
+        nu: &mut [f64],
+    ) -> Result<(), ImpactError> {
+        self.factor_active(mech, t, q, active)?;
+        let info = self.info;
+        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
+        mech.contact_gamma(t, q, qd, &mut self.gamma);
+        check_finite(Quantity::ContactJacobian, t, &self.gamma)?;
+        self.x.fill(0.0);
+        for c in 0..nc {
+            if active[c] {
+                self.x[n + m + c] = self.gamma[c] - dot(&self.d[c * n..(c + 1) * n], qdd);
+            }
+        }
+        self.lu.solve_vec(&mut self.x);
+        for (a, d) in qdd.iter_mut().zip(&self.x[..n]) {
+            *a += d;
+        }
+        for (l, d) in lambda.iter_mut().zip(&self.x[n..n + m]) {
+            *l += d;
+        }
+        for c in 0..nc {
+            nu[c] = if active[c] { self.x[n + m + c] } else { 0.0 };
+        }
+        Ok(())
+    }
+
+    /// Moves $(q, \dot q)$ back onto the contacts in `active` ($\delta = 0$,
+    /// $v_n = 0$) by the least-action corrections that keep $J\Delta q = 0$ and
+    /// $J\Delta\dot q = 0$ (one step for the positions: the drift between two steps
+    /// is small). Allocation-free.
+    ///
+    /// # Errors
+    /// A failed evaluation, or a singular matrix.
+    pub fn project_rest<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        active: &[bool],
+    ) -> Result<(), ImpactError> {
+        let info = self.info;
+        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
+        mech.contact_gaps(t, q, &mut self.gaps);
+        check_finite(Quantity::ContactGaps, t, &self.gaps)?;
+        self.factor_active(mech, t, q, active)?;
+        self.x.fill(0.0);
+        for c in 0..nc {
+            if active[c] {
+                self.x[n + m + c] = -self.gaps[c];
+            }
+        }
+        self.lu.solve_vec(&mut self.x);
+        for (a, d) in q.iter_mut().zip(&self.x[..n]) {
+            *a += d;
+        }
+        self.factor_active(mech, t, q, active)?;
+        self.x.fill(0.0);
+        for c in 0..nc {
+            if active[c] {
+                let vn = self.rate[c] + dot(&self.d[c * n..(c + 1) * n], qd);
+                self.x[n + m + c] = -vn;
+            }
+        }
+        self.lu.solve_vec(&mut self.x);
+        for (a, d) in qd.iter_mut().zip(&self.x[..n]) {
+            *a += d;
+        }
+        Ok(())
+    }
+
+    /// The normal accelerations $\dot v_n = D\ddot q - \gamma_c$ of every contact at
+    /// $(t, q, \dot q)$ with the accelerations `qdd`, into `out`.
+    ///
+    /// # Errors
+    /// A non-finite $D$ or $\gamma_c$.
+    pub fn normal_accelerations<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvalError> {
+        self.eval_contacts(mech, t, q)?;
+        mech.contact_gamma(t, q, qd, &mut self.gamma);
+        check_finite(Quantity::ContactJacobian, t, &self.gamma)?;
+        let n = self.info.nq();
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = dot(&self.d[c * n..(c + 1) * n], qdd) - self.gamma[c];
+        }
+        Ok(())
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -5,6 +5,7 @@
 mod animate;
 mod args;
 mod error;
+mod impacts;
 mod linearize;
 mod list;
 mod outputs;

@@ -93,6 +93,19 @@ pub fn trajectory(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), C
             .label(info.coordinates[j].name)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
+    if !run.impacts.is_empty() {
+        // Impacts: a vertical mark at each.
+        let mark = BLACK.mix(0.5);
+        chart
+            .draw_series(
+                run.impacts
+                    .iter()
+                    .map(|imp| PathElement::new([(imp.t, lo), (imp.t, hi)], mark.stroke_width(1))),
+            )
+            .map_err(|x| e(x.to_string()))?
+            .label("impacts")
+            .legend(move |(x, y)| PathElement::new([(x + 10, y - 6), (x + 10, y + 6)], mark));
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))

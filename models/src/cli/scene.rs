@@ -18,8 +18,14 @@ pub struct Steady {
     pub coordinates: &'static [(&'static str, f64)],
     /// `(name, value)` of velocities at the operating point, besides the speed.
     pub velocities: &'static [(&'static str, f64)],
-    /// The coordinate whose velocity `--speed` sets, and its default.
+    /// The coordinate whose velocity `--speed` sets, and the default speed.
     pub speed: Option<(&'static str, f64)>,
+    /// That velocity per unit of speed (a wheel's spin rate is `−v / r`); `None` for 1.
+    pub speed_ratio: Option<fn(&dyn Mechanism) -> f64>,
+    /// Coordinates whose velocities are states of the linearized system (the lean and
+    /// steer rates rather than the yaw rate); empty to leave the choice to the
+    /// partition.
+    pub independent_velocities: &'static [&'static str],
     /// Ignorable coordinates, dropped from the state matrix.
     pub ignorable: &'static [&'static str],
     /// What the steady motion is, for the report.
@@ -61,6 +67,8 @@ impl Scene {
                     coordinates: &[("x", 0.0), ("y", -1.0)],
                     velocities: &[],
                     speed: None,
+                    speed_ratio: None,
+                    independent_velocities: &[],
                     ignorable: &[],
                     summary: "hanging at rest",
                 }),
@@ -91,10 +99,62 @@ impl Scene {
                     coordinates: &[("x", 0.0), ("y", 0.0), ("phi", 0.0)],
                     velocities: &[("phi", 0.0)],
                     speed: Some(("x", 1.0)),
+                    speed_ratio: None,
+                    independent_velocities: &[],
                     ignorable: &["x", "y", "phi"],
                     summary: "straight motion along x",
                 }),
                 closed_form: Some(sleigh_exact),
+            },
+            "rolling_disk" => Self {
+                t_end: 5.0,
+                span: "several turns of a leaning disk",
+                steady: Some(Steady {
+                    coordinates: &[
+                        ("x", 0.0),
+                        ("y", 0.0),
+                        ("psi", 0.0),
+                        ("phi", 0.0),
+                        ("theta", 0.0),
+                    ],
+                    velocities: &[("psi", 0.0), ("phi", 0.0)],
+                    // Upright rolling along x: the centre moves at theta' · radius.
+                    speed: Some(("theta", 2.0)),
+                    speed_ratio: Some(|m| 1.0 / parameter(m, "radius")),
+                    independent_velocities: &["psi", "phi", "theta"],
+                    ignorable: &["x", "y", "psi", "theta"],
+                    summary: "upright rolling along x",
+                }),
+                closed_form: None,
+            },
+            "bicycle" => Self {
+                t_end: 5.0,
+                span: "5 s of riding from a lean-rate disturbance",
+                steady: Some(Steady {
+                    coordinates: &[
+                        ("x", 0.0),
+                        ("y", 0.0),
+                        ("psi", 0.0),
+                        ("phi", 0.0),
+                        ("delta", 0.0),
+                        ("theta_r", 0.0),
+                        ("theta_f", 0.0),
+                    ],
+                    velocities: &[("phi", 0.0), ("delta", 0.0)],
+                    // Upright straight running: the rear wheel spins at −v / r_r.
+                    speed: Some(("theta_r", 5.0)),
+                    speed_ratio: Some(|m| -1.0 / parameter(m, "r_r")),
+                    independent_velocities: &["phi", "delta", "theta_r"],
+                    ignorable: &["x", "y", "psi", "theta_r", "theta_f"],
+                    summary: "upright straight running",
+                }),
+                closed_form: None,
+            },
+            "spatial_four_bar" => Self {
+                t_end: 2.0,
+                span: "2 s of swinging",
+                steady: None,
+                closed_form: None,
             },
             "seed2_example1" => Self {
                 t_end: 2.0,
@@ -119,9 +179,102 @@ impl Scene {
                 steady: None,
                 closed_form: None,
             },
+            "bouncing_ball" => Self {
+                t_end: 1.0,
+                span: "the first two bounces; --t-end 2 shows the accumulation at 1.3546 s and the rest",
+                steady: None,
+                closed_form: Some(bouncing_ball_exact),
+            },
+            "falling_rod" => Self {
+                t_end: 0.08,
+                span: "the first impact and the flight after it",
+                steady: None,
+                closed_form: Some(falling_rod_exact),
+            },
+            "newtons_cradle" => Self {
+                t_end: 2.0,
+                span: "a few swings",
+                steady: None,
+                closed_form: None,
+            },
+            "pendulum_floor" | "sleigh_wall" | "body_impact" | "two_body_impact" => Self {
+                t_end: 1.0,
+                span: "1 s from the impact of its math-spec case",
+                steady: None,
+                closed_form: None,
+            },
             _ => Self::fallback(),
         }
     }
+}
+
+/// The bouncing ball (benchmark-models.md) without pull: free fall from rest at `h`,
+/// impact n at t_n = T(1 + 2 Σ_{k=1}^{n-1} e^k), T = √(2h/g), leaving at e^n √(2gh);
+/// at rest on the ground from t∞ = T(1+e)/(1−e).
+fn bouncing_ball_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
+    let (h, e, g) = (
+        parameter(model, "h"),
+        parameter(model, "e"),
+        parameter(model, "g"),
+    );
+    let tt = (2.0 * h / g).sqrt();
+    if t <= tt {
+        return vec![("y", h - 0.5 * g * t * t, -g * t)];
+    }
+    let mut t_n = tt;
+    let mut v = e * (2.0 * g * h).sqrt();
+    while v > 0.0 && t > t_n + 2.0 * v / g {
+        t_n += 2.0 * v / g;
+        v *= e;
+    }
+    if v <= 0.0 || t >= tt * (1.0 + e) / (1.0 - e) {
+        return vec![("y", 0.0, 0.0)];
+    }
+    let s = t - t_n;
+    vec![("y", v * s - 0.5 * g * s * s, v - g * s)]
+}
+
+/// The falling rod (benchmark-models.md) up to its second impact: the lower end strikes
+/// at t* = (v − speed)/g, v = √(speed² + 2 g gap) (t* = gap/speed for g = 0), with the
+/// impulse P = (1+e) m v/(1 + 3cos²φ); then ẏ⁺ = −v + P/m, φ̇⁺ = −6 P cos φ/(m l), and
+/// free flight.
+fn falling_rod_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
+    let p = |n| parameter(model, n);
+    let (l, m, angle, speed, gap, e, g) = (
+        p("l"),
+        p("m"),
+        p("angle"),
+        p("speed"),
+        p("gap"),
+        p("e"),
+        p("g"),
+    );
+    let y0 = gap + 0.5 * l * angle.sin();
+    let v = (speed * speed + 2.0 * g * gap).sqrt();
+    let t_star = if g == 0.0 {
+        gap / speed
+    } else {
+        (v - speed) / g
+    };
+    if t <= t_star {
+        return vec![
+            ("x", 0.0, 0.0),
+            ("y", y0 - speed * t - 0.5 * g * t * t, -speed - g * t),
+            ("phi", angle, 0.0),
+        ];
+    }
+    let imp = (1.0 + e) * m * v / (1.0 + 3.0 * angle.cos().powi(2));
+    let (yd, w) = (-v + imp / m, -6.0 * imp * angle.cos() / (m * l));
+    let s = t - t_star;
+    vec![
+        ("x", 0.0, 0.0),
+        (
+            "y",
+            y0 - speed * t_star - 0.5 * g * t_star * t_star + yd * s - 0.5 * g * s * s,
+            yd - g * s,
+        ),
+        ("phi", angle + w * s, w),
+    ]
 }
 
 fn parameter(model: &dyn Mechanism, name: &str) -> f64 {

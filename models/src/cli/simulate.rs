@@ -13,7 +13,7 @@ use serde_json::{json, Map, Value};
 use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
 use super::error::{failed, usage, CliError};
 use super::scene::Scene;
-use super::{animate, outputs, plot, setup};
+use super::{animate, impacts, outputs, plot, setup};
 
 /// A validated simulation request.
 pub struct Request<'a> {
@@ -207,6 +207,7 @@ fn kind_name(kind: &SimErrorKind) -> &'static str {
         SimErrorKind::NonFinite { .. } => "non_finite",
         SimErrorKind::Analysis(_) => "analysis",
         SimErrorKind::Integrator(_) => "integrator",
+        SimErrorKind::Impact(_) => "impact",
     }
 }
 
@@ -298,6 +299,8 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         },
         "energy": energies(model, run).map_or(Value::Null, |(a, b)| json!({"initial": a, "final": b})),
         "wall_seconds": out.wall.as_secs_f64(),
+        "impacts": impacts::json(info, run),
+        "contact_events": impacts::events_json(run),
     });
     if let Some(kind) = &out.error {
         // The rest of the object is the partial run; `stopped_at` is the time of its
@@ -400,6 +403,7 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
             let _ = writeln!(w, "energy       {}", no_energy(info, run));
         }
     }
+    impacts::summary(info, run, &mut w);
     match run.final_state() {
         Some((t, q, qd)) => {
             let list: Vec<String> = info

@@ -121,7 +121,15 @@ const TI32: f64 = 2.571_926_949_855_605_429_2;
 const TI33: f64 = -0.596_039_204_828_224_924_97;
 
 /// Radau IIA of order 5 with simplified Newton, a finite-difference Jacobian, error
-/// control and dense output; see the [module docs](self).
+/// control and dense output, after Hairer & Wanner's `radau5.f`.
+///
+/// Each step solves the collocation equations by a simplified Newton iteration with a
+/// finite-difference Jacobian of $f$ (reused while the iteration contracts fast) and
+/// one real and one complex factorization; the local error is controlled against the
+/// transformed tolerances $\text{rtol}' = 0.1\,\text{rtol}^{2/3}$,
+/// $\text{atol}' = \text{atol}\,\text{rtol}'/\text{rtol}$. Dense output is the
+/// collocation polynomial (order 3 inside the step). Non-convergence, a non-finite
+/// stage derivative or a recoverable failure of the system rejects the attempt.
 pub struct Radau5 {
     opts: OdeOptions,
     k: Coef,

@@ -106,7 +106,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
 
     /// Records a row at the current full state.
     fn record(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        self.sys.form.accelerations(&mut self.sys.point, t)?;
+        self.sys.accelerations(t)?;
         let v = self.observe(t)?;
         let p = &self.sys.point;
         let energy = self.monitors.energy_final.filter(|_| p.info.conservative);
@@ -173,12 +173,15 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats.stage_newton_iterations = o.newton_iterations;
             stats.restarts = o.restarts.saturating_sub(1);
         }
+        let (impacts, contact_events) = super::contacts::take(&self.sys);
         Run {
             trajectory: self.traj.clone(),
             stats,
             monitors: self.monitors,
             redundant_constraints: self.sys.point.redundant.clone(),
             overridden_velocities: self.overridden.clone(),
+            impacts,
+            contact_events,
             repartition_times: self.repartition_times.clone(),
         }
     }
@@ -222,6 +225,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             monitors: Monitors::default(),
             redundant_constraints: Vec::new(),
             overridden_velocities: Vec::new(),
+            impacts: Vec::new(),
+            contact_events: Vec::new(),
             repartition_times: Vec::new(),
         }),
     };
@@ -289,6 +294,21 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     if let Err(e) = sys.accept(t0) {
         return Err(empty(e));
     }
+    // Contacts closed at the start: impacts, then rest.
+    let mut h_first = None;
+    if sys.contacts.is_some() {
+        let r = super::contacts::handle(&mut sys, None, t0).and_then(|h| {
+            sys.accept(t0)?;
+            if let Some(c) = sys.contacts.as_mut() {
+                c.anchor(&sys.point, t0)?;
+            }
+            Ok(h)
+        });
+        match r {
+            Ok(h) => h_first = h,
+            Err(e) => return Err(empty(e)),
+        }
+    }
 
     let rows = match sim.output {
         Output::Steps => 1024,
@@ -334,7 +354,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         Err(e) => return Err(rec.fail(None, SimErrorKind::Integrator(e))),
     };
     rec.sys.gather(rec.y);
-    if let Err(e) = stepper.reset(&mut rec.sys, t0, rec.y, None) {
+    let min_h = super::min_step(t0, t_end);
+    let restart_step = |h: Option<f64>| match sim.method {
+        super::Method::Rk4 { .. } => None,
+        _ => h.map(|h| h.max(min_h).min(h_max)),
+    };
+    if let Err(e) = stepper.reset(&mut rec.sys, t0, rec.y, restart_step(h_first)) {
         let kind = failure(e, &mut rec.sys);
         return Err(rec.fail(Some(&stepper), kind));
     }
@@ -366,6 +391,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 steps: sim.max_steps
             });
         }
+        let t_prev = stepper.t();
         let partitions = rec.sys.point.kin.repartitions();
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
@@ -374,12 +400,77 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 bail!(kind)
             }
         };
+        // Contacts: the first event in the step truncates it there (rows before it from
+        // this step's dense output), the jump is applied and the integrator restarts.
+        if let Some(found) = check!(super::contacts::locate(&mut rec.sys, &stepper, t_prev)) {
+            let te = found.t();
+            while next_out < times.len() && times[next_out] < te {
+                let to = times[next_out];
+                check!(stepper.interpolate(to, &mut yout).map_err(ode));
+                check!(rec.sys.keep(to, &yout));
+                check!(rec.record(to));
+                next_out += 1;
+            }
+            check!(stepper.interpolate(te, &mut yout).map_err(ode));
+            check!(rec.sys.keep(te, &yout));
+            let before = rec
+                .sys
+                .point
+                .mech
+                .kinetic_energy(te, &rec.sys.point.q, &rec.sys.point.qd);
+            let h0 = match super::contacts::handle(&mut rec.sys, Some(found), te) {
+                Ok(h0) => h0,
+                Err(kind) => {
+                    // The run ends at the event, with the state before the jump.
+                    check!(stepper.interpolate(te, &mut yout).map_err(ode));
+                    check!(rec.sys.keep(te, &yout));
+                    if let Some(c) = rec.sys.contacts.as_mut() {
+                        c.clear_resting();
+                    }
+                    let _ = rec.record(te);
+                    return Err(rec.fail(None, kind));
+                }
+            };
+            check!(rec.sys.accept(te));
+            let after = rec
+                .sys
+                .point
+                .mech
+                .kinetic_energy(te, &rec.sys.point.q, &rec.sys.point.qd);
+            // The energy monitor measures the integration: the impacts' losses move its
+            // reference.
+            if let Some(e0) = rec.monitors.energy_initial.as_mut() {
+                *e0 -= before - after;
+            }
+            if steps_mode {
+                check!(rec.record(te));
+            } else {
+                check!(rec.observe(te));
+            }
+            if let Some(c) = rec.sys.contacts.as_mut() {
+                check!(c.anchor(&rec.sys.point, te));
+            }
+            rec.sys.gather(rec.y);
+            if let Err(e) = stepper.reset(&mut rec.sys, te, rec.y, restart_step(h0)) {
+                let kind = failure(e, &mut rec.sys);
+                bail!(kind)
+            }
+            if let Some(f) = sim.progress.as_mut() {
+                f(te);
+            }
+            continue;
+        }
         // The accepted state, corrected as the formulation keeps it (partitioning: the
         // point of the chart the integrator has just evaluated, polished; the
         // right-hand side is invariant to the move, so the integrator keeps its
         // derivatives), then the anchor of the next step.
         rec.y.copy_from_slice(stepper.y());
-        let correction = check!(rec.sys.keep(t, rec.y));
+        let mut correction = check!(rec.sys.keep(t, rec.y));
+        if let Some(c) = rec.sys.contacts.as_mut() {
+            if check!(c.project(&mut rec.sys.point, t)) {
+                correction = Correction::Changed;
+            }
+        }
         rec.sys.gather(rec.y);
         match correction {
             Correction::None => {}
@@ -398,6 +489,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             check!(rec.record(t));
         } else {
             check!(rec.observe(t));
+        }
+        if rec.sys.contacts.is_some() {
+            check!(rec.sys.accelerations(t));
+            if let Some(c) = rec.sys.contacts.as_mut() {
+                check!(c.anchor(&rec.sys.point, t));
+            }
         }
         while next_out < times.len() && times[next_out] <= t {
             let to = times[next_out];

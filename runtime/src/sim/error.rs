@@ -182,6 +182,10 @@ pub enum SimErrorKind {
     /// Another failure of the integrator (invalid tolerances or step sizes).
     #[error(transparent)]
     Integrator(OdeError),
+    /// An impact could not be solved (a singular configuration names the constraints
+    /// and contacts of the dependent set), or a resting contact's equations failed.
+    #[error(transparent)]
+    Impact(crate::ImpactError),
 }
 
 impl SimErrorKind {
@@ -195,6 +199,9 @@ impl SimErrorKind {
             | Self::StepSizeTooSmall { t, .. }
             | Self::MaxSteps { t, .. }
             | Self::NonFinite { t, .. } => Some(*t),
+            Self::Impact(
+                crate::ImpactError::Singular { t, .. } | crate::ImpactError::SingularMass { t, .. },
+            ) => Some(*t),
             _ => None,
         }
     }

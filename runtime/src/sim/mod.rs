@@ -92,6 +92,7 @@
 //! ```
 
 mod chart;
+mod contacts;
 mod driver;
 mod error;
 mod formulation;
@@ -101,6 +102,7 @@ mod stepper;
 mod system;
 mod trajectory;
 
+pub use contacts::{ContactEvent, ContactEventKind};
 pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
 pub use system::{Failed, StateSpace};

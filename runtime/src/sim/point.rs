@@ -171,6 +171,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         }
     }
 
+    /// Forgets $\ddot q$ and $\lambda$ (after a resting contact corrected them in
+    /// place, so that the next solve starts from the model's own equations).
+    pub fn invalidate_solved(&mut self) {
+        self.solved.valid = false;
+    }
+
     /// Keeps only the independent holonomic rows `holonomic` (and every non-holonomic
     /// one) in the projections, after assembly dropped redundant constraints
     /// (allocates).

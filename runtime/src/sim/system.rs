@@ -36,6 +36,8 @@ pub(crate) struct System<'a, M: Mechanism + ?Sized> {
     retries: u32,
     /// The failure of the last evaluation that failed.
     failure: Option<SimErrorKind>,
+    /// Contacts, impacts and resting contacts (models with contacts only).
+    pub contacts: Option<super::contacts::Contacts>,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for System<'_, M> {
@@ -62,7 +64,18 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
             form: AnyForm::new(formulation, n, m, mh, tolerances),
             retries: 0,
             failure: None,
+            contacts: super::contacts::Contacts::new(info, tolerances.0)?,
         })
+    }
+
+    /// $\ddot q$ and $\lambda$ at the full state of the point: the formulation's, with
+    /// the correction of resting contacts.
+    pub fn accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        self.form.accelerations(&mut self.point, t)?;
+        if let Some(c) = self.contacts.as_mut() {
+            c.correct(&mut self.point, t)?;
+        }
+        Ok(())
     }
 
     /// Takes the current full state (consistent, at `t`) as the last accepted one.
@@ -105,7 +118,7 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
         let r = self
             .form
             .reconstruct(&mut self.point, t, y)
-            .and_then(|()| self.form.accelerations(&mut self.point, t));
+            .and_then(|()| self.accelerations(t));
         match r {
             Ok(()) => {
                 dy[..n].copy_from_slice(&self.point.qd);

@@ -214,6 +214,11 @@ pub struct Run {
     /// Declared initial velocities that assembly had to change (see
     /// [`Kinematics::assemble_declared`](crate::Kinematics::assemble_declared)).
     pub overridden_velocities: Vec<crate::OverriddenVelocity>,
+    /// The impacts, in time order (one per contact that struck: simultaneous impacts
+    /// are resolved one contact at a time, see [`crate::sim`]).
+    pub impacts: Vec<crate::Impact>,
+    /// Contacts that came to rest (accumulated impacts) and released, in time order.
+    pub contact_events: Vec<super::ContactEvent>,
     /// The times of the accepted steps at which the partition was chosen anew (one per
     /// re-partition counted in [`Stats::repartitions`] after the start).
     pub repartition_times: Vec<f64>,

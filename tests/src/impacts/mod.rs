@@ -3,4 +3,5 @@
 //! its energy balance and its typed failure at a singular configuration.
 
 mod jacobian;
+mod sim;
 mod solve;

@@ -1,0 +1,267 @@
+//! Impacts inside simulations (math-spec §7.6): event location, the jump, the restart,
+//! accumulation into resting contact and its release, simultaneous contacts, and a
+//! singular impact as a typed error with the run kept. Closed forms are cited per test.
+
+use pfaff::sim::{ContactEventKind, Formulation, Method, Run, SimErrorKind, Simulation};
+use pfaff::{ImpactError, Mechanism};
+use pfaff_models::{bouncing_ball, falling_rod, newtons_cradle, pendulum_floor};
+
+fn methods() -> Vec<Method> {
+    vec![Method::Dopri5, Method::Dop853, Method::Adams]
+}
+
+fn formulations() -> Vec<Formulation> {
+    vec![
+        Formulation::Partitioning,
+        Formulation::Projection,
+        Formulation::baumgarte(),
+        Formulation::Unconstrained,
+    ]
+}
+
+fn run(model: &dyn Mechanism, f: Formulation, m: Method, t_end: f64) -> Run {
+    Simulation::new(model)
+        .formulation(f)
+        .integrator(m)
+        .tolerances(1e-10, 1e-12)
+        .output_every(0.01)
+        .run(t_end)
+        .unwrap_or_else(|e| panic!("{} {f:?} {m:?}: {e}", model.info().name))
+}
+
+/// The bouncing ball (h = 1, e = 0.5, g = 9.81): impact n at
+/// t_n = T (1 + 2 Σ_{k<n} e^k) with T = √(2h/g), rebound speed e^n √(2gh) (so the
+/// rebound height is e^{2n} h), and the accumulation time T (1+e)/(1−e)
+/// (benchmark-models.md), after which the ball rests on the ground.
+#[test]
+fn bouncing_ball_impact_times_heights_and_accumulation() {
+    let model = bouncing_ball::Model::default();
+    let (h, e, g) = (1.0_f64, 0.5_f64, 9.81_f64);
+    let tt = (2.0 * h / g).sqrt();
+    let v0 = (2.0 * g * h).sqrt();
+    let t_inf = tt * (1.0 + e) / (1.0 - e);
+    for f in formulations() {
+        for m in methods() {
+            let r = run(&model, f, m, 2.0);
+            assert!(
+                r.impacts.len() > 10,
+                "{f:?} {m:?}: {} impacts",
+                r.impacts.len()
+            );
+            let mut t_n = tt;
+            for (n, imp) in r.impacts.iter().take(10).enumerate() {
+                let k = i32::try_from(n).unwrap();
+                assert!(
+                    (imp.t - t_n).abs() < 1e-8,
+                    "{f:?} {m:?}: impact {n} at {} against {t_n}",
+                    imp.t
+                );
+                let v = e.powi(k + 1) * v0;
+                assert!(
+                    (imp.qd_after[0] - v).abs() < 1e-7,
+                    "{f:?} {m:?}: rebound {n}"
+                );
+                let height = imp.qd_after[0].powi(2) / (2.0 * g);
+                assert!((height - e.powi(2 * k + 2) * h).abs() < 1e-7);
+                assert!(imp.energy_lost() > 0.0);
+                t_n += 2.0 * e.powi(k + 1) * v0 / g;
+            }
+            let rest: Vec<_> = r
+                .contact_events
+                .iter()
+                .filter(|c| c.kind == ContactEventKind::Rest)
+                .collect();
+            assert_eq!(rest.len(), 1, "{f:?} {m:?}: {:?}", r.contact_events);
+            assert!(
+                (rest[0].t - t_inf).abs() < 1e-6,
+                "{f:?} {m:?}: rest at {} against {t_inf}",
+                rest[0].t
+            );
+            let (_, q, qd) = r.final_state().unwrap();
+            assert!(
+                q[0].abs() < 1e-9 && qd[0].abs() < 1e-9,
+                "{f:?} {m:?}: {q:?} {qd:?}"
+            );
+        }
+    }
+}
+
+/// At rest on the ground, an upward pull `pull_rate·(t − pull_start)` lifts the ball
+/// when it exceeds the weight, at t = pull_start + m g / pull_rate = 2 + 9.81/10; after
+/// it, ÿ = (F − m g)/m = 10 (t − t_r), so y = (10/6)(t − t_r)³.
+#[test]
+fn bouncing_ball_releases_under_an_upward_pull() {
+    let mut model = bouncing_ball::Model::default();
+    let info = model.info();
+    model.set_parameter(info.parameter_index("pull_rate").unwrap(), 10.0);
+    let t_r = 2.0 + 9.81 / 10.0;
+    for m in methods() {
+        let r = run(&model, Formulation::Partitioning, m, 3.5);
+        let release: Vec<_> = r
+            .contact_events
+            .iter()
+            .filter(|c| c.kind == ContactEventKind::Release)
+            .collect();
+        assert_eq!(release.len(), 1, "{m:?}: {:?}", r.contact_events);
+        assert!((release[0].t - t_r).abs() < 1e-6, "{m:?}: {}", release[0].t);
+        let (t, q, _) = r.final_state().unwrap();
+        let y = 10.0 / 6.0 * (t - t_r).powi(3);
+        assert!((q[0] - y).abs() < 1e-6, "{m:?}: y = {} against {y}", q[0]);
+    }
+}
+
+/// Falling rod (benchmark-models.md defaults): the lower end strikes at
+/// t* = (v − speed)/g with v = √(speed² + 2 g gap); then P = (1+e) m v / (1 + 3cos²φ),
+/// ẏ⁺ = −v + P/m, φ̇⁺ = −6 P cos φ/(m l).
+#[test]
+fn falling_rod_first_impact_against_the_closed_form() {
+    let model = falling_rod::Model::default();
+    let (speed, gap, g, e, phi) = (
+        1.0_f64,
+        0.01_f64,
+        9.81_f64,
+        0.5,
+        std::f64::consts::FRAC_PI_4,
+    );
+    let v = (speed * speed + 2.0 * g * gap).sqrt();
+    let t_star = (v - speed) / g;
+    let p = (1.0 + e) * v / (1.0 + 3.0 * phi.cos().powi(2));
+    for f in formulations() {
+        for m in methods() {
+            let r = run(&model, f, m, 0.05);
+            let imp = &r.impacts[0];
+            assert_eq!(imp.names, ["lower_end"]);
+            assert!((imp.t - t_star).abs() < 1e-9, "{f:?} {m:?}: {}", imp.t);
+            assert!((imp.impulses[0] - p).abs() < 1e-8);
+            assert!((imp.qd_after[1] - (-v + p)).abs() < 1e-8);
+            assert!((imp.qd_after[2] - (-6.0 * p * phi.cos())).abs() < 1e-8);
+        }
+    }
+}
+
+/// Newton's cradle, e = 1, equal masses: ball 1 strikes ball 2, which passes the
+/// impulse to ball 3 at the same instant (the sequential law): ball 1 and ball 2 stop,
+/// ball 3 leaves with ball 1's impact speed.
+#[test]
+fn newtons_cradle_one_ball_in_one_ball_out() {
+    let model = newtons_cradle::Model::default();
+    for m in methods() {
+        let r = run(&model, Formulation::Partitioning, m, 0.4);
+        assert!(r.impacts.len() >= 2, "{m:?}: {:?}", r.impacts.len());
+        let (a, b) = (&r.impacts[0], &r.impacts[1]);
+        assert_eq!(a.names, ["balls12"]);
+        assert_eq!(b.names, ["balls23"]);
+        assert_eq!(a.t, b.t);
+        let w = a.qd_before[0];
+        assert!(w > 0.0);
+        let after = &b.qd_after;
+        assert!(
+            after[0].abs() < 1e-12 * w && after[1].abs() < 1e-12 * w,
+            "{after:?}"
+        );
+        assert!((after[2] - w).abs() < 1e-12 * w, "{after:?}");
+        assert!(a.energy_lost().abs() < 1e-12 && b.energy_lost().abs() < 1e-12);
+    }
+}
+
+/// The double pendulum starts at V15's impact instant: the contact closed at t = 0 is
+/// handled before the first step, with V15's result (φ̇⁺ = (11/52, −67/52)).
+#[test]
+fn contact_closed_at_the_start_is_an_impact_at_t0() {
+    let model = pendulum_floor::Model::default();
+    for f in [Formulation::Partitioning, Formulation::Projection] {
+        for m in methods() {
+            let r = run(&model, f, m, 0.1);
+            let imp = &r.impacts[0];
+            assert_eq!(imp.t, 0.0);
+            assert!((imp.impulses[0] - 165.0 / 104.0).abs() < 1e-9);
+            assert!((imp.qd_after[2] - 11.0 / 52.0).abs() < 1e-9);
+            assert!((imp.qd_after[5] + 67.0 / 52.0).abs() < 1e-9);
+            let qd0 = r.trajectory.qd(0);
+            assert!(
+                (qd0[2] - 11.0 / 52.0).abs() < 1e-9,
+                "the first row is after the jump"
+            );
+        }
+    }
+}
+
+/// A ball on a rail written twice (a redundant constraint the simulation accepts):
+/// at the impact the rows of `[J; D]` are dependent, the impulses undetermined, and the
+/// run stops with the typed error naming the two rail rows, the rows before it kept.
+#[pfaff::mechanism]
+pub mod twice_railed {
+    const e: f64 = 0.5;
+    static x: Coordinate = Coordinate {};
+    static y: Coordinate = Coordinate { q0: 0.5 };
+    fn kinetic_energy() -> f64 {
+        0.5 * (x.dot().powi(2) + y.dot().powi(2))
+    }
+    fn potential_energy() -> f64 {
+        9.81 * y
+    }
+    /// The rail.
+    #[holonomic]
+    fn rail() -> f64 {
+        x
+    }
+    /// The rail again.
+    #[holonomic]
+    fn rail_again() -> f64 {
+        2.0 * x
+    }
+    /// The ground.
+    #[contact(e)]
+    fn floor() -> f64 {
+        y
+    }
+}
+
+#[test]
+fn singular_impact_stops_the_run_with_the_constraints_named() {
+    let model = twice_railed::Model::default();
+    let t_hit = (2.0 * 0.5 / 9.81_f64).sqrt();
+    let err = Simulation::new(&model)
+        .formulation(Formulation::Projection)
+        .output_every(0.01)
+        .run(1.0)
+        .expect_err("singular impact");
+    match &err.kind {
+        SimErrorKind::Impact(ImpactError::Singular { t, constraints }) => {
+            assert!((t - t_hit).abs() < 1e-6, "{t}");
+            assert!(constraints.contains(&"rail") && constraints.contains(&"rail_again"));
+            assert!(!constraints.contains(&"floor"), "{constraints:?}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let tr = &err.partial.trajectory;
+    assert!(tr.len() > 10, "rows kept: {}", tr.len());
+    assert!(*tr.t.last().unwrap() <= t_hit + 1e-9);
+}
+
+/// RK4 at a fixed step locates the impacts on its dense output as well; the rest comes
+/// when the remaining flights fit in a sample of a step (here within h of t∞).
+#[test]
+fn bouncing_ball_with_rk4() {
+    let model = bouncing_ball::Model::default();
+    let (h, e, g) = (1.0_f64, 0.5_f64, 9.81_f64);
+    let tt = (2.0 * h / g).sqrt();
+    let v0 = (2.0 * g * h).sqrt();
+    let step = 1e-3;
+    for f in formulations() {
+        let r = run(&model, f, Method::Rk4 { h: step }, 2.0);
+        let mut t_n = tt;
+        for (n, imp) in r.impacts.iter().take(5).enumerate() {
+            let k = i32::try_from(n).unwrap();
+            assert!((imp.t - t_n).abs() < 1e-8, "{f:?}: impact {n} at {}", imp.t);
+            t_n += 2.0 * e.powi(k + 1) * v0 / g;
+        }
+        let rest = r.contact_events[0];
+        assert_eq!(rest.kind, ContactEventKind::Rest);
+        assert!(
+            (rest.t - tt * (1.0 + e) / (1.0 - e)).abs() < step,
+            "{f:?}: {}",
+            rest.t
+        );
+    }
+}
