@@ -100,10 +100,13 @@ fn check_keys(v: &Value, with_error: bool) {
         stats,
         [
             "factorizations",
+            "jacobians",
             "newton_iterations",
             "rejected",
             "repartitions",
             "rhs_evals",
+            "stage_factorizations",
+            "stage_newton_iterations",
             "steps"
         ]
     );
@@ -324,7 +327,7 @@ fn simulate_takes_a_full_consistent_state_and_names_what_an_inconsistent_one_vio
 #[test]
 fn every_formulation_and_integrator_runs() {
     for f in ["partitioning", "projection", "baumgarte"] {
-        for i in ["rk4", "dopri5", "dop853", "adams"] {
+        for i in ["rk4", "dopri5", "dop853", "adams", "radau5"] {
             let out = pfaff(&[
                 "simulate",
                 "sleigh",
@@ -453,7 +456,7 @@ fn work_precision_table_csv_and_plot() {
     let text = stdout(&out);
     assert!(text.contains("closed-form"), "{text}");
     for f in ["partitioning", "projection", "baumgarte"] {
-        for i in ["rk4", "dopri5", "dop853", "adams"] {
+        for i in ["rk4", "dopri5", "dop853", "adams", "radau5"] {
             assert!(
                 text.lines().any(|l| l.starts_with(f) && l.contains(i)),
                 "no {f} {i} row in\n{text}"
@@ -464,9 +467,9 @@ fn work_precision_table_csv_and_plot() {
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,
-        "formulation,method,rtol,error,rhs_evals,steps,repartitions,wall_seconds,failure"
+        "formulation,method,rtol,error,rhs_evals,steps,jacobians,repartitions,wall_seconds,failure"
     );
-    assert_eq!(csv.lines().count(), 1 + 3 * 4 * 10);
+    assert_eq!(csv.lines().count(), 1 + 3 * 5 * 10);
     assert_svg(&dir.join("wp.svg"));
 }
 

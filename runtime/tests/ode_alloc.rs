@@ -6,7 +6,7 @@
 #![allow(unsafe_code)]
 
 use pfaff::ode::samples::Kepler;
-use pfaff::ode::{Adams, Dop853, Dopri5, Integrator, OdeOptions, Rk4};
+use pfaff::ode::{Adams, Dop853, Dopri5, Integrator, OdeOptions, Radau5, Rk4};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -82,6 +82,10 @@ fn stepping_does_not_allocate() {
         (
             "dop853",
             allocations_in_1000_steps(Dop853::new(4, o.clone()).unwrap()),
+        ),
+        (
+            "radau5",
+            allocations_in_1000_steps(Radau5::new(4, o.clone()).unwrap()),
         ),
         (
             "adams",

@@ -9,7 +9,8 @@
 //! accumulate at $t_\infty = \sqrt{2h/g}\,(1+e)/(1-e)$.
 
 use pfaff::ode::{
-    Adams, Crossing, Dop853, Dopri5, EventLocator, Integrator, OdeOptions, OdeSystem, RhsError,
+    Adams, Crossing, Dop853, Dopri5, EventLocator, Integrator, OdeOptions, OdeSystem, Radau5,
+    RhsError,
 };
 
 const G: f64 = 9.81;
@@ -104,6 +105,8 @@ fn v17_4_bouncing_ball_impact_times_and_accumulation() {
     check_times("dopri5", &t);
     let (t, _) = bounce(&mut Dop853::new(2, o.clone()).unwrap(), 25, |_| None);
     check_times("dop853", &t);
+    let (t, _) = bounce(&mut Radau5::new(2, o.clone()).unwrap(), 25, |_| None);
+    check_times("radau5", &t);
     let (t, orders) = bounce(&mut Adams::new(2, o).unwrap(), 25, |a: &Adams| {
         Some(a.last_order())
     });

@@ -61,6 +61,8 @@ pub enum IntegratorArg {
     Dop853,
     /// Shampine-Gordon variable-order Adams, adaptive.
     Adams,
+    /// Radau IIA of order 5, implicit, adaptive: for stiff models.
+    Radau5,
 }
 
 /// A `NAME=VALUE` pair.

@@ -93,6 +93,7 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
         IntegratorArg::Dopri5 => Method::Dopri5,
         IntegratorArg::Dop853 => Method::Dop853,
         IntegratorArg::Adams => Method::Adams,
+        IntegratorArg::Radau5 => Method::Radau5,
     };
     Ok(Request {
         args,
@@ -288,6 +289,9 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
             "newton_iterations": s.newton_iterations,
             "factorizations": s.factorizations,
             "repartitions": s.repartitions,
+            "jacobians": s.jacobians,
+            "stage_factorizations": s.stage_factorizations,
+            "stage_newton_iterations": s.stage_newton_iterations,
         },
         "max_violation": {
             "position": m.max_position_violation,
@@ -367,6 +371,13 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
         "work         {} steps ({} rejected), {} rhs evaluations, {} Newton iterations, {} factorizations, {} re-partitions",
         s.steps, s.rejected, s.rhs_evals, s.newton_iterations, s.factorizations, s.repartitions
     );
+    if s.jacobians > 0 {
+        let _ = writeln!(
+            w,
+            "implicit     {} Jacobians, {} factorizations, {} Newton iterations of the stages",
+            s.jacobians, s.stage_factorizations, s.stage_newton_iterations
+        );
+    }
     let _ = writeln!(w, "wall time    {:.3} ms", out.wall.as_secs_f64() * 1e3);
     let _ = writeln!(
         w,

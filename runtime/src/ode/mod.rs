@@ -14,6 +14,7 @@
 //! | [`Dopri5`] | Dormand–Prince 5(4), FSAL | mixed RMS norm, PI controller | order 4 |
 //! | [`Dop853`] | Dormand–Prince 8(5,3) | mixed RMS norm, 5th/3rd-order estimator | order 7 |
 //! | [`Adams`] | Shampine–Gordon `STEP`, orders 1–12, PECE | weighted 2-norm, see there | `INTRP` |
+//! | [`Radau5`] | Radau IIA order 5, implicit (stiff), simplified Newton, FD Jacobian | RMS norm, order-3 estimate, Gustafsson | collocation polynomial |
 //!
 //! All implement [`Integrator`]: [`reset`](Integrator::reset) (also a hard restart),
 //! [`step`](Integrator::step) (one accepted step, never past `t_stop`),
@@ -30,6 +31,7 @@ mod error;
 mod events;
 mod integrator;
 mod options;
+mod radau;
 mod rk4;
 mod rk_driver;
 pub mod samples;
@@ -42,5 +44,6 @@ pub use error::{OdeError, Quantity};
 pub use events::{Crossing, EventLocator};
 pub use integrator::Integrator;
 pub use options::{OdeOptions, OdeStats, Tolerances};
+pub use radau::Radau5;
 pub use rk4::Rk4;
 pub use system::{OdeSystem, RhsError};

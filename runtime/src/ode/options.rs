@@ -177,4 +177,12 @@ pub struct OdeStats {
     pub restarts: u64,
     /// Calls to `set_state`.
     pub state_updates: u64,
+    /// Jacobians $\partial f/\partial y$ formed (implicit methods; their evaluations
+    /// of the right-hand side are counted in `rhs_evals` too).
+    pub jac_evals: u64,
+    /// Factorizations of the iteration matrices (implicit methods; one per step size
+    /// and Jacobian, covering the real and the complex system of [`Radau5`](super::Radau5)).
+    pub factorizations: u64,
+    /// Iterations of the stage equations' simplified Newton method (implicit methods).
+    pub newton_iterations: u64,
 }

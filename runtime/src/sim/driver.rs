@@ -22,7 +22,7 @@ use super::formulation::Correction;
 use super::stepper::Stepper;
 use super::system::System;
 use super::trajectory::{Monitors, Run, Stats, Trajectory};
-use super::{Formulation, Output, Simulation};
+use super::{Formulation, Method, Output, Simulation};
 use crate::assembly::write_prescription;
 use crate::kinematics::KinematicsError;
 use crate::ode::{OdeError, OdeOptions, OdeSystem, Tolerances};
@@ -168,6 +168,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats.steps = o.steps;
             stats.rejected = o.rejected;
             stats.rhs_evals = o.rhs_evals;
+            stats.jacobians = o.jac_evals;
+            stats.stage_factorizations = o.factorizations;
+            stats.stage_newton_iterations = o.newton_iterations;
             stats.restarts = o.restarts.saturating_sub(1);
         }
         let (impacts, contact_events) = super::contacts::take(&self.sys);
@@ -254,7 +257,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         sim.formulation,
         sim.kinematics,
         sim.dynamics,
-        (sim.rtol, sim.atol),
+        chart_tolerances(sim.method, sim.rtol, sim.atol),
     )
     .map_err(|e| empty(SimErrorKind::Analysis(e)))?;
     let pq: Vec<(&str, f64)> = sim
@@ -536,5 +539,21 @@ fn failure<M: Mechanism + ?Sized>(e: OdeError, sys: &mut System<'_, M>) -> SimEr
             .take_failure()
             .unwrap_or_else(|| SimErrorKind::from_ode(e)),
         other => SimErrorKind::from_ode(other),
+    }
+}
+
+/// The tolerances the partitioning chart's Newton iteration stops at (a fraction
+/// [`KAPPA`](super::chart::KAPPA) of them). An implicit method differentiates the
+/// right-hand side by finite differences, with increments near $\sqrt{u}$ of the
+/// state: an iteration stopped at the integrator's tolerance would leave a noise of
+/// that size in $f$, and $10^8$ times it in the Jacobian. For it the chart iterates to
+/// round-off ([`NEWTON_TOLERANCE`](super::NEWTON_TOLERANCE), relative).
+fn chart_tolerances(method: Method, rtol: f64, atol: f64) -> (f64, f64) {
+    match method {
+        Method::Radau5 => {
+            let tight = super::NEWTON_TOLERANCE;
+            (tight, atol * tight / rtol.max(tight))
+        }
+        _ => (rtol, atol),
     }
 }

@@ -202,10 +202,12 @@ pub enum Method {
     Dop853,
     /// Shampine–Gordon variable-order Adams.
     Adams,
+    /// Radau IIA of order 5, implicit, for stiff systems (see [`crate::ode::Radau5`]).
+    Radau5,
 }
 
 impl Method {
-    /// The adaptive methods.
+    /// The adaptive explicit methods.
     pub const ADAPTIVE: [Self; 3] = [Self::Dopri5, Self::Dop853, Self::Adams];
 
     /// A short name.
@@ -216,6 +218,7 @@ impl Method {
             Self::Dopri5 => "dopri5",
             Self::Dop853 => "dop853",
             Self::Adams => "adams",
+            Self::Radau5 => "radau5",
         }
     }
 }

@@ -92,6 +92,7 @@ impl Sweep {
                 Method::Dopri5,
                 Method::Dop853,
                 Method::Adams,
+                Method::Radau5,
             ],
         }
     }
@@ -112,6 +113,8 @@ pub struct Row {
     pub rhs_evals: u64,
     /// Accepted steps.
     pub steps: u64,
+    /// Jacobians formed by an implicit integrator (their evaluations are in `rhs_evals`).
+    pub jacobians: u64,
     /// Re-partitions.
     pub repartitions: u64,
     /// Wall-clock time.
@@ -161,6 +164,7 @@ pub fn work_precision<M: Mechanism + ?Sized>(
                     },
                     rhs_evals: run.stats.rhs_evals,
                     steps: run.stats.steps,
+                    jacobians: run.stats.jacobians,
                     repartitions: run.stats.repartitions,
                     wall_time: run.stats.wall_time,
                     failure,
@@ -177,19 +181,20 @@ pub fn format_table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<13} {:<7} {:>8} {:>10} {:>9} {:>8} {:>6} {:>11}",
-        "formulation", "method", "rtol", "error", "rhs", "steps", "repart", "wall [ms]"
+        "{:<13} {:<7} {:>8} {:>10} {:>9} {:>8} {:>6} {:>6} {:>11}",
+        "formulation", "method", "rtol", "error", "rhs", "steps", "jac", "repart", "wall [ms]"
     );
     for r in rows {
         let _ = write!(
             s,
-            "{:<13} {:<7} {:>8.0e} {:>10.2e} {:>9} {:>8} {:>6} {:>11.3}",
+            "{:<13} {:<7} {:>8.0e} {:>10.2e} {:>9} {:>8} {:>6} {:>6} {:>11.3}",
             r.formulation.name(),
             r.method.name(),
             r.rtol,
             r.error,
             r.rhs_evals,
             r.steps,
+            r.jacobians,
             r.repartitions,
             r.wall_time.as_secs_f64() * 1e3
         );

@@ -1,9 +1,9 @@
-//! Run-time choice of the integrator: an enum over the four methods, since
+//! Run-time choice of the integrator: an enum over the five methods, since
 //! [`Integrator`] has generic methods and is not object safe.
 
 use super::Method;
 use crate::ode::{
-    Adams, Dop853, Dopri5, Integrator, OdeError, OdeOptions, OdeStats, OdeSystem, Rk4,
+    Adams, Dop853, Dopri5, Integrator, OdeError, OdeOptions, OdeStats, OdeSystem, Radau5, Rk4,
 };
 
 // One stepper lives per run, so the size of the largest variant (Adams' history) costs
@@ -15,6 +15,7 @@ pub(crate) enum Stepper {
     Dopri5(Dopri5),
     Dop853(Dop853),
     Adams(Adams),
+    Radau5(Radau5),
 }
 
 macro_rules! each {
@@ -24,6 +25,7 @@ macro_rules! each {
             Stepper::Dopri5($i) => $body,
             Stepper::Dop853($i) => $body,
             Stepper::Adams($i) => $body,
+            Stepper::Radau5($i) => $body,
         }
     };
 }
@@ -35,6 +37,7 @@ impl Stepper {
             Method::Dopri5 => Self::Dopri5(Dopri5::new(dim, opts)?),
             Method::Dop853 => Self::Dop853(Dop853::new(dim, opts)?),
             Method::Adams => Self::Adams(Adams::new(dim, opts)?),
+            Method::Radau5 => Self::Radau5(Radau5::new(dim, opts)?),
         })
     }
 

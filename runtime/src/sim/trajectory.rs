@@ -153,6 +153,13 @@ pub struct Stats {
     pub factorizations: u64,
     /// Re-partitions (monitor or recovery from a failed Newton iteration).
     pub repartitions: u64,
+    /// Jacobians of the right-hand side formed by an implicit integrator
+    /// ([`Method::Radau5`](super::Method::Radau5)); their evaluations are in `rhs_evals`.
+    pub jacobians: u64,
+    /// Factorizations of an implicit integrator's iteration matrices.
+    pub stage_factorizations: u64,
+    /// Simplified Newton iterations of an implicit integrator's stage equations.
+    pub stage_newton_iterations: u64,
     /// Restarts of the integrator after the first start.
     pub restarts: u64,
     /// Wall-clock time of [`run`](super::Simulation::run), assembly included.

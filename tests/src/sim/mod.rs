@@ -17,4 +17,5 @@ mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
+mod stiff;
 mod units;
