@@ -40,6 +40,8 @@
 // each file holds `pub mod <name> { … }` and is mounted under a private name here.
 #[path = "andrews.rs"]
 mod andrews_model;
+#[path = "bicycle.rs"]
+mod bicycle_model;
 #[path = "body_impact.rs"]
 mod body_impact_model;
 #[path = "bouncing_ball.rs"]
@@ -58,6 +60,8 @@ mod parallelogram_model;
 mod pendulum_floor_model;
 #[path = "pendulum.rs"]
 mod pendulum_model;
+#[path = "rolling_disk.rs"]
+mod rolling_disk_model;
 #[path = "seed2_example1.rs"]
 mod seed2_example1_model;
 #[path = "seed2_example2.rs"]
@@ -72,8 +76,11 @@ mod sleigh_wall_model;
 mod slider_crank_bodies_model;
 #[path = "slider_crank.rs"]
 mod slider_crank_model;
+#[path = "spatial_four_bar.rs"]
+mod spatial_four_bar_model;
 
 pub use andrews_model::andrews;
+pub use bicycle_model::bicycle;
 pub use body_impact_model::{body_impact, two_body_impact};
 pub use bouncing_ball_model::bouncing_ball;
 pub use car_axis_model::car_axis;
@@ -83,6 +90,7 @@ pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
 pub use pendulum_floor_model::pendulum_floor;
 pub use pendulum_model::pendulum;
+pub use rolling_disk_model::rolling_disk;
 pub use seed2_example1_model::seed2_example1;
 pub use seed2_example2_model::seed2_example2;
 pub use sleigh_bodies_model::sleigh_bodies;
@@ -90,6 +98,7 @@ pub use sleigh_model::sleigh;
 pub use sleigh_wall_model::sleigh_wall;
 pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
+pub use spatial_four_bar_model::spatial_four_bar;
 
 /// A built-in model as listed by the command-line program.
 #[derive(Clone, Copy, Debug)]
@@ -127,6 +136,21 @@ static ALL: &[Entry] = &[
         name: "free_body",
         summary: "torque-free spatial rigid body with Euler parameters (math-spec V12)",
         make: || Box::new(free_body::Model::default()),
+    },
+    Entry {
+        name: "rolling_disk",
+        summary: "thin uniform disk rolling without slip on a plane",
+        make: || Box::new(rolling_disk::Model::default()),
+    },
+    Entry {
+        name: "bicycle",
+        summary: "Whipple bicycle benchmark (Meijaard, Papadopoulos, Ruina, Schwab 2007)",
+        make: || Box::new(bicycle::Model::default()),
+    },
+    Entry {
+        name: "spatial_four_bar",
+        summary: "spatial four-bar (revolute, spherical, universal) with Euler parameters",
+        make: || Box::new(spatial_four_bar::Model::default()),
     },
     Entry {
         name: "andrews",

@@ -7,7 +7,7 @@
 /// gravity `g` along −y. The coordinates `x`, `y` of the bob are tied by the link,
 /// $x^2 + y^2 - l^2 = 0$. It starts at rest at $x = l$, $y = 0$; the period is
 /// $4K(1/2)\sqrt{l/g} = 2.36784194757624$ s for the defaults.
-#[pfaff::mechanism]
+#[pfaff::mechanism(linearize)]
 pub mod pendulum {
     /// Mass of the bob [kg].
     const m: f64 = 1.0;

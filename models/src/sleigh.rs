@@ -10,7 +10,7 @@
 /// The defaults start at the origin with forward speed 1 and turning rate 0.5; the
 /// turning rate then decays while the forward speed tends to
 /// $V = \sqrt{v_0^2 + (i_c + m a^2)\,\omega_0^2/m} = 1.014273138755$.
-#[pfaff::mechanism]
+#[pfaff::mechanism(linearize)]
 pub mod sleigh {
     /// Mass [kg].
     const m: f64 = 2.0;

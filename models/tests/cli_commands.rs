@@ -396,6 +396,43 @@ fn linearize_sleigh_at_a_speed() {
     );
 }
 
+/// The steady motion is the whole operating point: the model's declared initial
+/// velocities (the bicycle starts with a lean rate, the sleigh turning) do not leak
+/// into it. At 5 m/s the bicycle's eigenvalues are those of Meijaard et al. (2007) as
+/// quoted in benchmark-models.md, plus the neutral forward speed.
+#[test]
+fn linearize_bicycle_at_its_benchmark_speed() {
+    let out = pfaff(&["linearize", "bicycle", "--speed", "5", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(v["method"], "generated derivatives");
+    assert_eq!(v["operating_point"]["qd"]["phi"].as_f64(), Some(0.0));
+    let eig: Vec<(f64, f64)> = v["eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| (e["re"].as_f64().unwrap(), e["im"].as_f64().unwrap()))
+        .collect();
+    let want = [
+        (-14.078_389_692_798_22, 0.0),
+        (-0.775_341_882_195_85, -4.464_867_713_788_23),
+        (-0.775_341_882_195_85, 4.464_867_713_788_23),
+        (-0.322_866_429_004_09, 0.0),
+        (0.0, 0.0),
+    ];
+    assert_eq!(eig.len(), want.len(), "{eig:?}");
+    for (g, w) in eig.iter().zip(want) {
+        assert!(
+            (g.0 - w.0).abs() < 1e-9 && (g.1 - w.1).abs() < 1e-9,
+            "{eig:?}"
+        );
+    }
+    let sleigh = pfaff(&["linearize", "sleigh", "--speed", "2", "--json"]);
+    let v: Value = serde_json::from_str(&stdout(&sleigh)).unwrap();
+    assert_eq!(v["operating_point"]["qd"]["phi"].as_f64(), Some(0.0));
+    assert_eq!(v["operating_point"]["qd"]["x"].as_f64(), Some(2.0));
+}
+
 #[test]
 fn work_precision_table_csv_and_plot() {
     let dir = scratch("work_precision");

@@ -76,7 +76,8 @@ pub use impact::{Impact, ImpactError, ImpactSolver};
 pub use joint_reactions::{JointReaction, JointReactions, Wrench};
 pub use kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams, NewtonStats};
 pub use linearize::{
-    linearize, Eigenvalue, Linearization, LinearizeError, LinearizeParams, StateComponent,
+    linearize, linearize_with, Eigenvalue, Linearization, LinearizeError, LinearizeMethod,
+    LinearizeParams, StateComponent, States,
 };
 pub use mechanism::{
     Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,

@@ -247,6 +247,10 @@ pub struct Info {
     pub contact_pattern: Pattern,
     /// Arrays of run-time model data.
     pub data: &'static [DataSlot],
+    /// The pattern of [`Mechanism::linearization_jacobian`] (rows of the stacked
+    /// residuals, columns `[q; q̇]`), when the model emits it (`#[mechanism(linearize)]`);
+    /// `None` otherwise, and [`linearize`](crate::linearize) then uses differences.
+    pub linearization: Option<Pattern>,
 }
 
 impl Info {
@@ -278,6 +282,7 @@ impl Info {
         contacts: &[],
         contact_pattern: &[],
         data: &[],
+        linearization: None,
     };
 }
 
@@ -537,6 +542,34 @@ pub trait Mechanism {
     /// The contact normal Jacobian `D = ∂gap/∂q`, as values of [`Info::contact_pattern`].
     fn contact_jacobian(&self, t: f64, q: &[f64], out: &mut [f64]) {
         let _ = (t, q);
+        out.fill(0.0);
+    }
+
+    /// The Jacobian with respect to `[q; q̇]` (columns `0..n`, then `n..2n`) of the
+    /// stacked residuals
+    ///
+    /// ```text
+    /// rows 0..n          M(q) a + C_qᵀ λ_h + Gᵀ λ_nh − Q(q, q̇, t)
+    /// rows n..n+m_h      C_q a − γ_h
+    /// next m_nh rows     G a − γ_nh
+    /// next m_h rows      C_q q̇ + C_t
+    /// next m_nh rows     G q̇ + g
+    /// ```
+    ///
+    /// with `inputs = [a; λ_h; λ_nh]` held fixed (length `n + m_h + m_nh`), as values of
+    /// [`Info::linearization`]. At a solution `(a, λ)` of the index-1 equations these are
+    /// the partial derivatives of the linearized equations of motion; see
+    /// [`linearize`](crate::linearize). Generated for `#[mechanism(linearize)]`; the default
+    /// writes zeros.
+    fn linearization_jacobian(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        inputs: &[f64],
+        out: &mut [f64],
+    ) {
+        let _ = (t, q, qd, inputs);
         out.fill(0.0);
     }
 

@@ -8,7 +8,6 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pfaff::Mechanism;
-use proc_macro2::TokenStream;
 
 fn op_count_table() {
     println!("\noperation counts (naive tree = derivatives without simplification or sharing)");
@@ -16,9 +15,8 @@ fn op_count_table() {
         "{:<16} {:>14} {:>16} {:>10} {:>12}",
         "model", "naive tree", "simplified tree", "emitted", "naive/emit"
     );
-    for (name, tokens) in pfaff_tests::sources::model_sources() {
-        let c =
-            pfaff_codegen::measure::op_counts(TokenStream::new(), tokens).expect("model expands");
+    for (name, args, tokens) in pfaff_tests::sources::model_sources_with_args() {
+        let c = pfaff_codegen::measure::op_counts(args, tokens).expect("model expands");
         #[allow(clippy::cast_precision_loss)]
         let ratio = c.naive_tree as f64 / c.emitted.max(1) as f64;
         println!(
@@ -32,9 +30,9 @@ fn op_count_table() {
 fn expand(c: &mut Criterion) {
     op_count_table();
     let mut group = c.benchmark_group("expand");
-    for (name, tokens) in pfaff_tests::sources::model_sources() {
+    for (name, args, tokens) in pfaff_tests::sources::model_sources_with_args() {
         group.bench_function(&name, |b| {
-            b.iter(|| pfaff_codegen::expand(TokenStream::new(), black_box(tokens.clone())));
+            b.iter(|| pfaff_codegen::expand(args.clone(), black_box(tokens.clone())));
         });
     }
     group.finish();

@@ -17,6 +17,8 @@ mod fuzz;
 #[cfg(test)]
 mod impacts;
 #[cfg(test)]
+mod linear;
+#[cfg(test)]
 mod replay;
 #[cfg(test)]
 mod sim;

@@ -76,6 +76,9 @@ pub fn op_counts(args: TokenStream, input: TokenStream) -> syn::Result<OpCounts>
     })
 }
 
+/// Largest tree (in operations) that [`Analysis::describe`] prints as a formula.
+const TREE_PRINT_LIMIT: u128 = 2000;
+
 impl Analysis {
     /// Every derived quantity as an infix formula, one per line, with the model's names
     /// (`x'` is the velocity of `x`). This is the symbolic layer of the snapshot tests.
@@ -87,10 +90,26 @@ impl Analysis {
             Var::Qd(i) => format!("{}'", m.coords[i as usize].name),
             Var::Delta(i) => format!("δ{}", m.coords[i as usize].name),
             Var::Param(i) => m.params[i as usize].name.to_string(),
+            Var::Input(i) => format!("u{i}"),
         };
         let g = &self.graph;
         let d = &self.derived;
-        let f = |e: ExprId| display::to_infix(g, e, &name);
+        // A formula whose tree is large (a bicycle's γ) would print as megabytes of
+        // text: it is summarized, and the emitted code (linear in the DAG) shows it.
+        let all: Vec<ExprId> = functions(d).into_iter().flatten().collect();
+        let sizes: std::collections::HashMap<ExprId, u128> = all
+            .iter()
+            .copied()
+            .zip(transform::tree_op_counts(g, &all))
+            .collect();
+        let f = |e: ExprId| {
+            let ops = sizes.get(&e).copied().unwrap_or(0);
+            if ops > TREE_PRINT_LIMIT {
+                format!("⟨{ops} operations as a tree; see the emitted code⟩")
+            } else {
+                display::to_infix(g, e, &name)
+            }
+        };
         let mut s = String::new();
         let coord = |i: u32| m.coords[i as usize].name.to_string();
         let _ = writeln!(s, "T = {}", f(d.kinetic));

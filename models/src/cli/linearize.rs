@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use pfaff::{linearize, LinearizeParams};
+use pfaff::{linearize_with, LinearizeParams, States};
 use serde_json::json;
 
 use super::args::LinearizeArgs;
@@ -19,11 +19,13 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
     let mut guesses: Vec<(&str, f64)> = Vec::new();
     let mut velocities: Vec<(&str, f64)> = Vec::new();
     let mut ignorable: &[&str] = &[];
+    let mut independent: &[&str] = &[];
     let mut about = "the initial state".to_owned();
     if let Some(steady) = scene.steady {
         guesses.extend(steady.coordinates);
         velocities.extend(steady.velocities);
         ignorable = steady.ignorable;
+        independent = steady.independent_velocities;
         about = steady.summary.to_owned();
         if let Some((coordinate, default)) = steady.speed {
             let v = args.speed.unwrap_or(default);
@@ -32,13 +34,14 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
                     "invalid --speed {v}: expected a finite number"
                 )));
             }
-            velocities.push((coordinate, v));
+            let ratio = steady.speed_ratio.map_or(1.0, |f| f(model.as_ref()));
+            velocities.push((coordinate, ratio * v));
             about = format!("{about} at speed {v}");
         }
     }
     if args.speed.is_some() && scene.steady.and_then(|s| s.speed).is_none() {
         return Err(usage(format!(
-            "model `{}` defines no steady forward motion, so --speed does not apply (it does for: sleigh)",
+            "model `{}` defines no steady forward motion, so --speed does not apply (it does for: sleigh, rolling_disk, bicycle)",
             entry.name
         )));
     }
@@ -63,12 +66,15 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
         );
     }
     let init = setup::assemble(model.as_ref(), &args.state, &guesses, &velocities)?;
-    let lin = linearize(
+    let lin = linearize_with(
         model.as_ref(),
         0.0,
         &init.q,
         &init.qd,
-        ignorable,
+        States {
+            ignorable,
+            velocities: independent,
+        },
         &LinearizeParams::default(),
     )
     .map_err(|e| failed(format!("cannot linearize `{}`: {e}", entry.name)).kind("linearize"))?;
@@ -91,6 +97,7 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
             "states": lin.states.iter().map(ToString::to_string).collect::<Vec<_>>(),
             "eigenvalues": lin.eigenvalues.iter().map(|e| json!({"re": e.re, "im": e.im})).collect::<Vec<_>>(),
             "state_matrix": rows,
+            "method": lin.method.to_string(),
             "error_estimate": lin.error_estimate,
         });
         println!("{value}");
@@ -136,8 +143,14 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
     }
     let _ = writeln!(
         w,
-        "difference error estimate max|A_h - A_2h| = {:.1e}",
-        lin.error_estimate
+        "{}",
+        match lin.method {
+            pfaff::LinearizeMethod::Differences => format!(
+                "central differences, error estimate max|A_h - A_2h| = {:.1e}",
+                lin.error_estimate
+            ),
+            _ => "generated derivatives (exact up to rounding)".to_owned(),
+        }
     );
     for note in &init.notes {
         let _ = writeln!(w, "note             {note}");

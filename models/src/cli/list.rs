@@ -111,7 +111,7 @@ pub fn show(name: &str) -> Result<String, CliError> {
             "linearize about: {}{}",
             s.summary,
             s.speed.map_or(String::new(), |(c, v)| format!(
-                " (--speed sets {c}', default {v})"
+                " (--speed sets the forward speed through {c}', default {v})"
             ))
         );
     }

@@ -18,8 +18,14 @@ pub struct Steady {
     pub coordinates: &'static [(&'static str, f64)],
     /// `(name, value)` of velocities at the operating point, besides the speed.
     pub velocities: &'static [(&'static str, f64)],
-    /// The coordinate whose velocity `--speed` sets, and its default.
+    /// The coordinate whose velocity `--speed` sets, and the default speed.
     pub speed: Option<(&'static str, f64)>,
+    /// That velocity per unit of speed (a wheel's spin rate is `−v / r`); `None` for 1.
+    pub speed_ratio: Option<fn(&dyn Mechanism) -> f64>,
+    /// Coordinates whose velocities are states of the linearized system (the lean and
+    /// steer rates rather than the yaw rate); empty to leave the choice to the
+    /// partition.
+    pub independent_velocities: &'static [&'static str],
     /// Ignorable coordinates, dropped from the state matrix.
     pub ignorable: &'static [&'static str],
     /// What the steady motion is, for the report.
@@ -61,6 +67,8 @@ impl Scene {
                     coordinates: &[("x", 0.0), ("y", -1.0)],
                     velocities: &[],
                     speed: None,
+                    speed_ratio: None,
+                    independent_velocities: &[],
                     ignorable: &[],
                     summary: "hanging at rest",
                 }),
@@ -91,10 +99,62 @@ impl Scene {
                     coordinates: &[("x", 0.0), ("y", 0.0), ("phi", 0.0)],
                     velocities: &[("phi", 0.0)],
                     speed: Some(("x", 1.0)),
+                    speed_ratio: None,
+                    independent_velocities: &[],
                     ignorable: &["x", "y", "phi"],
                     summary: "straight motion along x",
                 }),
                 closed_form: Some(sleigh_exact),
+            },
+            "rolling_disk" => Self {
+                t_end: 5.0,
+                span: "several turns of a leaning disk",
+                steady: Some(Steady {
+                    coordinates: &[
+                        ("x", 0.0),
+                        ("y", 0.0),
+                        ("psi", 0.0),
+                        ("phi", 0.0),
+                        ("theta", 0.0),
+                    ],
+                    velocities: &[("psi", 0.0), ("phi", 0.0)],
+                    // Upright rolling along x: the centre moves at theta' · radius.
+                    speed: Some(("theta", 2.0)),
+                    speed_ratio: Some(|m| 1.0 / parameter(m, "radius")),
+                    independent_velocities: &["psi", "phi", "theta"],
+                    ignorable: &["x", "y", "psi", "theta"],
+                    summary: "upright rolling along x",
+                }),
+                closed_form: None,
+            },
+            "bicycle" => Self {
+                t_end: 5.0,
+                span: "5 s of riding from a lean-rate disturbance",
+                steady: Some(Steady {
+                    coordinates: &[
+                        ("x", 0.0),
+                        ("y", 0.0),
+                        ("psi", 0.0),
+                        ("phi", 0.0),
+                        ("delta", 0.0),
+                        ("theta_r", 0.0),
+                        ("theta_f", 0.0),
+                    ],
+                    velocities: &[("phi", 0.0), ("delta", 0.0)],
+                    // Upright straight running: the rear wheel spins at −v / r_r.
+                    speed: Some(("theta_r", 5.0)),
+                    speed_ratio: Some(|m| -1.0 / parameter(m, "r_r")),
+                    independent_velocities: &["phi", "delta", "theta_r"],
+                    ignorable: &["x", "y", "psi", "theta_r", "theta_f"],
+                    summary: "upright straight running",
+                }),
+                closed_form: None,
+            },
+            "spatial_four_bar" => Self {
+                t_end: 2.0,
+                span: "2 s of swinging",
+                steady: None,
+                closed_form: None,
             },
             "seed2_example1" => Self {
                 t_end: 2.0,

@@ -114,6 +114,12 @@ pub fn assemble(
     let n = info.nq();
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     model.initial_state(&mut q, &mut qd);
+    if !guesses.is_empty() || !guess_velocities.is_empty() {
+        // A steady motion is a complete operating point: the velocities it names, and
+        // the others at rest or as its constraints make them, not the model's declared
+        // initial velocities.
+        qd.fill(0.0);
+    }
     for &(name, v) in guesses {
         if let Some(i) = info.coordinate_index(name) {
             q[i] = v;

@@ -16,8 +16,9 @@ use super::reference::Reference;
 use super::sweep;
 use super::util::{dense, max_abs, max_diff, solve};
 
-/// Math-spec V5: all terms of the multiplier formula active.
-#[pfaff::mechanism]
+/// Math-spec V5: all terms of the multiplier formula active; with the linearization
+/// Jacobian, whose explicit time dependence and non-diagonal mass matrix it exercises.
+#[pfaff::mechanism(linearize)]
 pub mod v5 {
     /// First coordinate.
     static q1: Coordinate = Coordinate {};

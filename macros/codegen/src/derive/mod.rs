@@ -21,6 +21,7 @@ mod checks;
 pub mod contacts;
 pub mod drawing;
 pub mod free_motion;
+pub mod linear;
 
 use crate::ctxt::Ctxt;
 use crate::model::expr::{Context, Translator};
@@ -89,6 +90,8 @@ pub struct Derived {
     pub bodies: Option<bodies::BodyLevel>,
     /// Named outputs: name, docs, expression.
     pub outputs: Vec<(String, String, ExprId)>,
+    /// The linearization Jacobian, for `#[mechanism(linearize)]`.
+    pub linear: Option<linear::Linear>,
     /// Contacts (`#[contact(e)]` gap functions) and their normal Jacobian.
     pub contacts: contacts::Contacts,
 }
@@ -474,7 +477,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         outs.push((name, docs, e?));
     }
     let contacts = contacts::derive(cx, model, g, contact_rows, &param_defaults, checking)?;
-    Some(Derived {
+    let mut derived = Derived {
         contacts,
         holonomic_names,
         nonholonomic_names,
@@ -498,7 +501,13 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         homogeneous,
         conservative,
         free_motion,
-    })
+        linear: None,
+    };
+    // Not in a raw graph: the naive operation counts measure the simulation's functions.
+    if model.linearize && checking {
+        derived.linear = Some(linear::derive(g, &derived, n));
+    }
+    Some(derived)
 }
 
 /// The entries of row `r` of a pattern-ordered matrix.

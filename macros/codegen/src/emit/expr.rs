@@ -28,6 +28,8 @@ pub struct Printer<'a> {
     pub g: &'a Graph,
     pub prog: &'a Program,
     pub names: &'a dyn Names,
+    /// When set, temporary `k` is element `k` of this local array instead of a `let`.
+    pub array: Option<Ident>,
 }
 
 fn wrap(ts: TokenStream, prec: Prec, need: Prec) -> TokenStream {
@@ -64,6 +66,10 @@ impl Printer<'_> {
     pub fn expr(&self, id: ExprId, define: bool) -> (TokenStream, Prec) {
         if !define {
             if let Some(k) = self.prog.temp(id) {
+                if let Some(array) = &self.array {
+                    let k = proc_macro2::Literal::usize_unsuffixed(k);
+                    return (quote!(#array[#k]), Prec::Atom);
+                }
                 let name = self.names.temp(k);
                 return (quote!(#name), Prec::Atom);
             }

@@ -19,6 +19,9 @@ use crate::sched::{self, Program};
 use crate::sym::{ExprId, Graph, Var};
 use expr::{Names, Printer};
 
+/// Most temporaries a generated function binds with `let` (see [`body`]).
+const MAX_LETS: usize = 2000;
+
 /// Names of leaves and temporaries in generated code.
 struct ModelNames {
     coords: Vec<Ident>,
@@ -27,6 +30,12 @@ struct ModelNames {
     temp_prefix: String,
     /// The argument of `free_motion_residual` holding the applied forces.
     applied: String,
+    /// The argument of `linearization_jacobian` holding the accelerations and
+    /// multipliers, and the prefix of its entries' names.
+    inputs: String,
+    input_prefix: String,
+    /// The local array of temporaries of long functions.
+    temps: String,
 }
 
 /// `name` without the `r#` of a raw identifier, the text generated names are built on.
@@ -69,12 +78,30 @@ impl ModelNames {
         while declared.contains(&applied) {
             applied.push('_');
         }
+        let mut temps = String::from("temps");
+        while declared.contains(&temps) {
+            temps.push('_');
+        }
+        let mut inputs = String::from("inputs");
+        while declared.contains(&inputs) {
+            inputs.push('_');
+        }
+        let mut input_prefix = format!("{inputs}_");
+        while declared.iter().any(|n| {
+            n.strip_prefix(input_prefix.as_str())
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+        }) {
+            input_prefix.push('_');
+        }
         ModelNames {
             coords: model.coords.iter().map(|c| c.name.clone()).collect(),
             velocities,
             params: model.params.iter().map(|p| p.name.clone()).collect(),
             temp_prefix,
             applied,
+            inputs,
+            input_prefix,
+            temps,
         }
     }
 }
@@ -87,6 +114,7 @@ impl Names for ModelNames {
             Var::Qd(i) => self.velocities[i as usize].clone(),
             Var::Param(i) => self.params[i as usize].clone(),
             Var::Delta(i) => format_ident!("delta_{}", plain(&self.coords[i as usize])),
+            Var::Input(i) => format_ident!("{}{}", self.input_prefix, i),
         }
     }
     fn temp(&self, k: usize) -> Ident {
@@ -103,10 +131,16 @@ fn body(
     store: impl Fn(usize, TokenStream) -> TokenStream,
 ) -> (TokenStream, Program) {
     let prog = sched::schedule(g, roots);
+    // Every `let` opens a debug-info scope nested in the previous one; LLVM's DWARF
+    // writer recurses through that chain, and ten thousand of them (a bicycle's
+    // linearization Jacobian) overflow the compiler's stack. Long functions keep their
+    // temporaries in one local array instead.
+    let array = (prog.lets.len() > MAX_LETS).then(|| Ident::new(&names.temps, Span::call_site()));
     let printer = Printer {
         g,
         prog: &prog,
         names,
+        array: array.clone(),
     };
     let mut out = TokenStream::new();
     for v in &prog.vars {
@@ -123,12 +157,27 @@ fn body(
             }
             Var::Param(_) => quote!(let #name = self.params.#name;),
             Var::Delta(_) => unreachable!("variations never reach generated code"),
+            Var::Input(i) => {
+                let inputs = Ident::new(&names.inputs, Span::call_site());
+                let i = Literal::u32_unsuffixed(*i);
+                quote!(let #name = #inputs[#i];)
+            }
         });
     }
-    for (k, &id) in prog.lets.iter().enumerate() {
-        let name = names.temp(k);
-        let (ts, _) = printer.expr(id, true);
-        out.extend(quote!(let #name = #ts;));
+    if let Some(array) = &array {
+        let len = Literal::usize_unsuffixed(prog.lets.len());
+        out.extend(quote!(let mut #array = [0.0_f64; #len];));
+        for (k, &id) in prog.lets.iter().enumerate() {
+            let (ts, _) = printer.expr(id, true);
+            let k = Literal::usize_unsuffixed(k);
+            out.extend(quote!(#array[#k] = #ts;));
+        }
+    } else {
+        for (k, &id) in prog.lets.iter().enumerate() {
+            let name = names.temp(k);
+            let (ts, _) = printer.expr(id, true);
+            out.extend(quote!(let #name = #ts;));
+        }
     }
     for (k, &r) in roots.iter().enumerate() {
         let (ts, _) = printer.expr(r, false);
@@ -313,6 +362,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         fns.extend(vector_fn(g, &names, "applied_forces", &d.applied, true));
     }
     let free_motion = free_motion(g, &names, model, d, &mut fns);
+    let linearization = linearization(g, &names, d, &mut fns);
     if !d.c.is_empty() {
         fns.extend(vector_fn(g, &names, "holonomic", &d.c, false));
         fns.extend(vector_fn(
@@ -450,6 +500,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 outputs: #outputs,
                 #contact_info
                 data: &[],
+                linearization: #linearization,
                 #structure
             };
 
@@ -470,6 +521,36 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
             }
         }
     }
+}
+
+/// The linearization Jacobian (`derive::linear`) as the trait method
+/// `linearization_jacobian` (added to `fns`); returns the `Info::linearization` value.
+fn linearization(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream) -> TokenStream {
+    let Some(lin) = &d.linear else {
+        return quote!(::core::option::Option::None);
+    };
+    let (code, prog) = body(g, names, &entries(&lin.entries), |k, ts| {
+        let k = Literal::usize_unsuffixed(k);
+        quote!(out[#k] = #ts;)
+    });
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
+    let inputs = arg(&prog, &names.inputs, |v| matches!(v, Var::Input(_)));
+    fns.extend(quote! {
+        fn linearization_jacobian(
+            &self,
+            #t: f64,
+            #q: &[f64],
+            #qd: &[f64],
+            #inputs: &[f64],
+            out: &mut [f64],
+        ) {
+            #code
+        }
+    });
+    let pattern = pattern(&lin.entries);
+    quote!(::core::option::Option::Some(#pattern))
 }
 
 /// The free-motion residual `w = w0 + K Q` (math-spec §8.6) as the trait methods

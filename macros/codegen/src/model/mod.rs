@@ -57,6 +57,8 @@ pub struct Model {
     /// Body-level declarations (frames, points, bodies, joints, force elements), in
     /// declaration order.
     pub decls: Vec<Decl>,
+    /// `#[mechanism(linearize)]`: emit the linearization Jacobian.
+    pub linearize: bool,
 }
 
 impl Model {
@@ -120,6 +122,7 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         outputs: Vec::new(),
         contacts: Vec::new(),
         decls: Vec::new(),
+        linearize: ast.linearize,
     };
     let mut seen: HashMap<String, syn::Ident> = HashMap::new();
     let mut declare = |name: &syn::Ident| {

@@ -21,6 +21,8 @@ pub struct Mechanism {
     /// Non-doc attributes of the module, forwarded to the output.
     pub attrs: Vec<syn::Attribute>,
     pub items: Vec<Item>,
+    /// `#[mechanism(linearize)]`.
+    pub linearize: bool,
 }
 
 /// A declaration inside the module.
@@ -100,8 +102,15 @@ pub enum Role {
 
 /// Parses the attribute arguments and the module.
 pub fn parse(cx: &Ctxt, args: TokenStream, input: TokenStream) -> Option<Mechanism> {
+    let mut linearize = false;
     if !args.is_empty() {
-        cx.error_spanned_by(&args, "`#[mechanism]` takes no arguments");
+        match syn::parse2::<syn::Ident>(args.clone()) {
+            Ok(id) if id == "linearize" => linearize = true,
+            _ => cx.error_spanned_by(
+                &args,
+                "`#[mechanism]` takes no arguments or `linearize` (emit the derivatives of the linearized equations)",
+            ),
+        }
     }
     let module: syn::ItemMod = match syn::parse2(input) {
         Ok(m) => m,
@@ -131,6 +140,7 @@ pub fn parse(cx: &Ctxt, args: TokenStream, input: TokenStream) -> Option<Mechani
         docs,
         attrs,
         items,
+        linearize,
     })
 }
 

@@ -16,6 +16,7 @@ fn kind(v: Var) -> Deps {
         Var::Qd(_) => Deps::QD,
         Var::Delta(_) => Deps::DELTA,
         Var::Param(_) => Deps::PARAM,
+        Var::Input(_) => Deps::INPUT,
     }
 }
 

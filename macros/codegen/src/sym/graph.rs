@@ -49,6 +49,9 @@ pub enum Var {
     Delta(u32),
     /// Model parameter `p_i`.
     Param(u32),
+    /// Entry `i` of a vector the caller passes at run time (the accelerations and
+    /// multipliers at which the linearization Jacobian is evaluated).
+    Input(u32),
 }
 
 /// A node of the DAG.
@@ -95,6 +98,7 @@ impl Deps {
     pub const QD: Deps = Deps(4);
     pub const DELTA: Deps = Deps(8);
     pub const PARAM: Deps = Deps(16);
+    pub const INPUT: Deps = Deps(32);
 
     fn of(v: Var) -> Deps {
         match v {
@@ -103,6 +107,7 @@ impl Deps {
             Var::Qd(_) => Deps::QD,
             Var::Delta(_) => Deps::DELTA,
             Var::Param(_) => Deps::PARAM,
+            Var::Input(_) => Deps::INPUT,
         }
     }
     /// Whether any of the kinds in `other` is present.

@@ -105,6 +105,13 @@ pub fn substitute(
 /// Number of arithmetic operations to evaluate `roots` as trees (no sharing), counted
 /// the way [`op_count`] counts a node. Saturates instead of overflowing.
 pub fn tree_op_count(g: &Graph, roots: &[ExprId]) -> u128 {
+    tree_op_counts(g, roots)
+        .into_iter()
+        .fold(0u128, u128::saturating_add)
+}
+
+/// [`tree_op_count`] of each root separately, in one pass over the graph.
+pub fn tree_op_counts(g: &Graph, roots: &[ExprId]) -> Vec<u128> {
     let mut cost = vec![0u128; g.len()];
     for id in post_order(g, roots) {
         let own = node_ops(g.node(id));
@@ -115,9 +122,7 @@ pub fn tree_op_count(g: &Graph, roots: &[ExprId]) -> u128 {
             .fold(0u128, |s, a| s.saturating_add(cost[a.index()]));
         cost[id.index()] = sub.saturating_add(own);
     }
-    roots
-        .iter()
-        .fold(0u128, |s, r| s.saturating_add(cost[r.index()]))
+    roots.iter().map(|r| cost[r.index()]).collect()
 }
 
 /// Number of arithmetic operations to evaluate `roots` with every shared node computed

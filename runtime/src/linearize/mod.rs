@@ -22,6 +22,14 @@
 //! $\max |\partial f_w/\partial c|$ over the kept rows $w$ and dropped columns $c$, so a
 //! caller can see whether the removal was legitimate.
 //!
+//! **Generated derivatives.** A model declared `#[mechanism(linearize)]` emits
+//! [`Mechanism::linearization_jacobian`], the exact partial derivatives of the equations
+//! of motion and of the constraints at every level. The state matrix is then the tangent
+//! of the reduced map obtained from them by three linear solves (see `generated.rs`):
+//! exact up to rounding, with no step to choose, and [`LinearizeMethod::Auto`] (the
+//! default) uses it. Other models, or [`LinearizeMethod::Differences`], take the
+//! difference path below.
+//!
 //! **Difference step.** Column $j$ of $A$ is the central difference
 //! $(f(y + h_j e_j) - f(y - h_j e_j)) / 2h_j$ with
 //! $h_j = \varepsilon^{1/3}\max(|y_j|, s_j)$, $\varepsilon$ = [`f64::EPSILON`], where
@@ -41,6 +49,8 @@
 //! dominates. Eigenvalues of a non-defective $A$ move by at most
 //! $\kappa(V)\,\lVert\delta A\rVert$ ($V$ the eigenvectors; Bauer–Fike).
 
+mod generated;
+
 use crate::dynamics::{Dynamics, DynamicsError, DynamicsParams};
 use crate::kinematics::{Kinematics, KinematicsError, KinematicsParams, NewtonParams};
 use crate::linalg::inf_norm;
@@ -48,9 +58,34 @@ use crate::partition::{Partition, PartitionError, PartitionParams, Preferences};
 use crate::workspace::{check_state, EvalError, Workspace};
 use crate::Mechanism;
 
+/// How the state matrix is obtained.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LinearizeMethod {
+    /// The generated derivatives when the model has them, differences otherwise.
+    #[default]
+    Auto,
+    /// The generated derivatives ([`Mechanism::linearization_jacobian`]); an error for a
+    /// model without them.
+    Generated,
+    /// Central differences of the reduced map (see the module docs).
+    Differences,
+}
+
+impl std::fmt::Display for LinearizeMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Auto => "auto",
+            Self::Generated => "generated derivatives",
+            Self::Differences => "central differences",
+        })
+    }
+}
+
 /// Tuning of [`linearize`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearizeParams {
+    /// Generated derivatives or differences.
+    pub method: LinearizeMethod,
     /// Relative difference step $h_j / \max(|y_j|, s_j)$ (see the module docs); default
     /// $\varepsilon^{1/3}$.
     pub relative_step: f64,
@@ -63,6 +98,7 @@ pub struct LinearizeParams {
 impl Default for LinearizeParams {
     fn default() -> Self {
         Self {
+            method: LinearizeMethod::Auto,
             relative_step: f64::EPSILON.cbrt(),
             kinematics: KinematicsParams {
                 newton: NewtonParams {
@@ -119,7 +155,11 @@ pub struct Linearization {
     pub state_matrix: Vec<f64>,
     /// Eigenvalues of $A$, sorted by real part, then imaginary part.
     pub eigenvalues: Vec<Eigenvalue>,
-    /// $\max |A_h - A_{2h}|$ (see the module docs).
+    /// The method used ([`LinearizeMethod::Generated`] or
+    /// [`LinearizeMethod::Differences`]).
+    pub method: LinearizeMethod,
+    /// With differences, $\max |A_h - A_{2h}|$ (see the module docs); with generated
+    /// derivatives 0, the matrix being exact up to rounding.
     pub error_estimate: f64,
     /// $\max |\partial f_w / \partial c|$ over kept rows and dropped coordinates (0 when
     /// nothing is dropped).
@@ -158,6 +198,18 @@ pub enum LinearizeError {
         name: &'static str,
         /// Why.
         source: PartitionError,
+    },
+    /// [`LinearizeMethod::Generated`] was asked of a model without the derivatives.
+    #[error("model `{model}` emits no linearization derivatives: declare it `#[mechanism(linearize)]`, or use differences")]
+    NotGenerated {
+        /// The model.
+        model: &'static str,
+    },
+    /// A stage of the generated tangent map is singular at the operating point.
+    #[error("the linearized {stage} is singular at the operating point")]
+    SingularTangent {
+        /// Which solve.
+        stage: &'static str,
     },
     /// The relative difference step is not a positive finite number.
     #[error("invalid relative difference step {0:e}, expected a positive finite value")]
@@ -340,6 +392,44 @@ pub fn linearize<M: Mechanism + ?Sized>(
     ignorable: &[&str],
     params: &LinearizeParams,
 ) -> Result<Linearization, LinearizeError> {
+    linearize_with(
+        mech,
+        t,
+        q,
+        qd,
+        States {
+            ignorable,
+            velocities: &[],
+        },
+        params,
+    )
+}
+
+/// The choice of the reduced state beyond what the partition decides.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct States<'a> {
+    /// Coordinates kept independent and dropped from the state matrix (see
+    /// [`linearize`]).
+    pub ignorable: &'a [&'a str],
+    /// Coordinates whose velocities must be independent (states of the reduced system):
+    /// the lean and steer rates of a bicycle, say, rather than the yaw rate.
+    pub velocities: &'a [&'a str],
+}
+
+/// [`linearize`] with a choice of the independent velocities.
+///
+/// # Errors
+/// As [`linearize`]; an unknown name in `states.velocities` is
+/// [`LinearizeError::UnknownCoordinate`].
+pub fn linearize_with<M: Mechanism + ?Sized>(
+    mech: &M,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    states: States<'_>,
+    params: &LinearizeParams,
+) -> Result<Linearization, LinearizeError> {
+    let ignorable = states.ignorable;
     let info = mech.info();
     check_state(info, t, q, Some(qd))?;
     let rel = params.relative_step;
@@ -356,10 +446,21 @@ pub fn linearize<M: Mechanism + ?Sized>(
                 })
         })
         .collect::<Result<_, _>>()?;
+    let velocities: Vec<usize> = states
+        .velocities
+        .iter()
+        .map(|&name| {
+            info.coordinate_index(name)
+                .ok_or_else(|| LinearizeError::UnknownCoordinate {
+                    name: name.to_owned(),
+                    expected: info.coordinates.iter().map(|s| s.name).collect(),
+                })
+        })
+        .collect::<Result<_, _>>()?;
     let mut ws = Workspace::new(info)?;
     let prefs = Preferences {
         coordinates: &dropped,
-        velocities: &[],
+        velocities: &velocities,
     };
     let partition = Partition::compute(mech, &mut ws, t, q, prefs, &params.kinematics.partition)
         .map_err(|e| match e {
@@ -379,6 +480,14 @@ pub fn linearize<M: Mechanism + ?Sized>(
         .chain(&gamma)
         .copied()
         .collect();
+    let generated = match (params.method, info.linearization) {
+        (LinearizeMethod::Differences, _) => None,
+        (_, Some(pattern)) => Some((pattern, partition.clone())),
+        (LinearizeMethod::Generated, None) => {
+            return Err(LinearizeError::NotGenerated { model: info.name })
+        }
+        (LinearizeMethod::Auto, None) => None,
+    };
     let mut kin = Kinematics::new(info, params.kinematics);
     kin.set_partition(partition);
     let (mut q0, mut qd0) = (q.to_vec(), qd.to_vec());
@@ -401,14 +510,32 @@ pub fn linearize<M: Mechanism + ?Sized>(
         qdd: vec![0.0; n],
         lambda: vec![0.0; m],
     };
-    let y0 = reduced.state();
-    let h = reduced.steps(&y0, rel)?;
-    let a_h = reduced.jacobian(&y0, &h, 1.0)?;
-    let a_2h = reduced.jacobian(&y0, &h, 2.0)?;
-    let error_estimate = a_h
-        .iter()
-        .zip(&a_2h)
-        .fold(0.0_f64, |e, (x, y)| e.max((x - y).abs()));
+    let (a_h, error_estimate, method) = if let Some((pattern, partition)) = generated {
+        let r = &mut reduced;
+        r.dynamics.accelerations(
+            r.mech,
+            &mut r.ws,
+            t,
+            &r.q0,
+            &r.qd0,
+            &mut r.qdd,
+            &mut r.lambda,
+        )?;
+        let a = generated::state_matrix(
+            mech, pattern, &partition, t, &r.q0, &r.qd0, &r.qdd, &r.lambda,
+        )?;
+        (a, 0.0, LinearizeMethod::Generated)
+    } else {
+        let y0 = reduced.state();
+        let h = reduced.steps(&y0, rel)?;
+        let a_h = reduced.jacobian(&y0, &h, 1.0)?;
+        let a_2h = reduced.jacobian(&y0, &h, 2.0)?;
+        let error_estimate = a_h
+            .iter()
+            .zip(&a_2h)
+            .fold(0.0_f64, |e, (x, y)| e.max((x - y).abs()));
+        (a_h, error_estimate, LinearizeMethod::Differences)
+    };
 
     // Reduced state components; keep all but the dropped coordinates.
     let mut all: Vec<StateComponent> = reduced
@@ -443,6 +570,7 @@ pub fn linearize<M: Mechanism + ?Sized>(
         states: kept.iter().map(|&k| all[k]).collect(),
         state_matrix,
         eigenvalues,
+        method,
         error_estimate,
         dropped_coupling,
         partition: names,
