@@ -28,6 +28,8 @@ pub mod parse;
 #[cfg(test)]
 mod robustness;
 pub mod sched;
+#[cfg(test)]
+mod sparsity;
 pub mod sym;
 
 use proc_macro2::TokenStream;

@@ -71,16 +71,12 @@ pub fn derive(g: &mut Graph, d: &Derived, n: usize) -> Linear {
     let mut entries = Vec::new();
     for (r, t) in terms.into_iter().enumerate() {
         let residual = g.add(t);
-        for (c, v) in (0..n)
-            .map(|j| Var::Q(idx(j)))
-            .chain((0..n).map(|j| Var::Qd(idx(j))))
-            .enumerate()
-        {
-            let e = diff::differentiate(g, residual, v);
-            if !g.is_zero(e) {
+        // Columns: the coordinates, then the velocities (only those present).
+        for (offset, var) in [(0, Var::Q as fn(u32) -> Var), (n, Var::Qd)] {
+            for (j, e) in diff::gradient(g, residual, n, var) {
                 entries.push(Entry {
                     row: idx(r),
-                    col: idx(c),
+                    col: idx(offset + j as usize),
                     expr: e,
                 });
             }

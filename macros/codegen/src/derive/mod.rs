@@ -247,19 +247,17 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         .collect();
     let mut mass = Vec::new();
     for i in 0..n {
-        for j in 0..n {
-            let m = diff::differentiate(g, momenta[i], Var::Qd(idx(j)));
-            if checking && j >= i && g.deps(m).has(Deps::QD) {
-                checks::not_quadratic(cx, model, g, m, i, j);
+        // Only the velocities present in p_i (the others give zeros).
+        for (j, m) in diff::gradient(g, momenta[i], n, Var::Qd) {
+            if checking && j as usize >= i && g.deps(m).has(Deps::QD) {
+                checks::not_quadratic(cx, model, g, m, i, j as usize);
                 return None;
             }
-            if !g.is_zero(m) {
-                mass.push(Entry {
-                    row: idx(i),
-                    col: idx(j),
-                    expr: m,
-                });
-            }
+            mass.push(Entry {
+                row: idx(i),
+                col: j,
+                expr: m,
+            });
         }
     }
     let mut forces = Vec::with_capacity(n);
@@ -303,17 +301,14 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         }
         let r = c.len();
         let mut rate_terms = Vec::new();
-        for j in 0..n {
-            let d = diff::differentiate(g, h, Var::Q(idx(j)));
-            if !g.is_zero(d) {
-                cq.push(Entry {
-                    row: idx(r),
-                    col: idx(j),
-                    expr: d,
-                });
-                rate_terms.push(g.mul(vec![d, qv[j]]));
-            }
-        }
+        diff::for_each_partial(g, h, n, Var::Q, &mut |g, j, d| {
+            cq.push(Entry {
+                row: idx(r),
+                col: j,
+                expr: d,
+            });
+            rate_terms.push(g.mul(vec![d, qv[j as usize]]));
+        });
         let h_t = diff::differentiate(g, h, Var::Time);
         rate_terms.push(h_t);
         let cdot = g.add(rate_terms);
@@ -338,19 +333,16 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         let nh = item.expr;
         let r = gb.len();
         let mut row = Vec::new();
-        for j in 0..n {
-            let d = diff::differentiate(g, nh, Var::Qd(idx(j)));
+        for (j, d) in diff::gradient(g, nh, n, Var::Qd) {
             if checking && g.deps(d).has(Deps::QD) {
                 checks::not_linear(cx, model, g, &item, d);
                 return None;
             }
-            if !g.is_zero(d) {
-                row.push(Entry {
-                    row: idx(r),
-                    col: idx(j),
-                    expr: d,
-                });
-            }
+            row.push(Entry {
+                row: idx(r),
+                col: j,
+                expr: d,
+            });
         }
         if checking && !checks::nonholonomic(cx, &item, g, row.is_empty()) {
             continue;

@@ -22,6 +22,7 @@
 //! `a / b = a · b⁻¹`. The emitter turns them back into `-`, `-` and `/`.
 
 use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 use super::op::Func;
 
@@ -33,6 +34,11 @@ impl ExprId {
     /// The position of the node in creation order.
     pub fn index(self) -> usize {
         self.0 as usize
+    }
+
+    /// The id of the `i`-th node (for walks over a whole graph).
+    pub fn from_index(i: usize) -> ExprId {
+        ExprId(u32::try_from(i).expect("expression graph too large"))
     }
 }
 
@@ -100,7 +106,8 @@ impl Deps {
     pub const PARAM: Deps = Deps(16);
     pub const INPUT: Deps = Deps(32);
 
-    fn of(v: Var) -> Deps {
+    /// The kind of a variable.
+    pub fn of(v: Var) -> Deps {
         match v {
             Var::Time => Deps::TIME,
             Var::Q(_) => Deps::Q,
@@ -117,7 +124,15 @@ impl Deps {
     fn union(self, other: Deps) -> Deps {
         Deps(self.0 | other.0)
     }
+    /// The bit of a single kind (for per-kind flags).
+    pub(crate) fn bits(self) -> u8 {
+        self.0
+    }
 }
+
+/// The set of variables a node depends on: sorted, without repeats, shared between
+/// nodes whose sets are equal to an operand's.
+pub type VarSet = Arc<[Var]>;
 
 /// The expression DAG.
 #[derive(Debug)]
@@ -127,6 +142,29 @@ pub struct Graph {
     lookup: HashMap<Node, ExprId>,
     canonical: bool,
     pub(crate) diff_memo: HashMap<(ExprId, Var), ExprId>,
+    /// Per node, its variable set once computed (lazily, by [`Graph::var_set`]).
+    vars: Vec<Option<VarSet>>,
+    /// Per node, the kinds ([`Deps`] bits) for which differentiation has visited the
+    /// node and, through it, every operand of that kind (see `diff::differentiate`).
+    pub(crate) primed: Vec<u8>,
+    /// Whether differentiation skips absent variables (see `diff`); off only to compare
+    /// with the full walk.
+    pub(crate) skip_absent: bool,
+}
+
+/// The union of sorted variable sets, sharing an operand's set when it is the union.
+fn union_sets(sets: &[VarSet]) -> VarSet {
+    let Some(largest) = sets.iter().max_by_key(|s| s.len()) else {
+        return Arc::from(Vec::new());
+    };
+    let mut all: Vec<Var> = sets.iter().flat_map(|s| s.iter().copied()).collect();
+    all.sort_unstable();
+    all.dedup();
+    if all.len() == largest.len() {
+        largest.clone()
+    } else {
+        Arc::from(all)
+    }
 }
 
 impl Default for Graph {
@@ -144,6 +182,9 @@ impl Graph {
             lookup: HashMap::new(),
             canonical: true,
             diff_memo: HashMap::new(),
+            vars: Vec::new(),
+            primed: Vec::new(),
+            skip_absent: true,
         }
     }
 
@@ -153,6 +194,22 @@ impl Graph {
             canonical: false,
             ..Graph::new()
         }
+    }
+
+    /// A canonical graph whose differentiation walks every node of the variable's kind,
+    /// as before variable sets existed: the reference the skipping walk must reproduce
+    /// node for node.
+    #[cfg(test)]
+    pub(crate) fn full_walk() -> Graph {
+        Graph {
+            skip_absent: false,
+            ..Graph::new()
+        }
+    }
+
+    /// Whether differentiation may skip the nodes a variable is absent from.
+    pub(crate) fn skips_absent(&self) -> bool {
+        self.canonical && self.skip_absent
     }
 
     /// Whether constructors simplify.
@@ -168,6 +225,53 @@ impl Graph {
     /// Dependency summary of a node.
     pub fn deps(&self, id: ExprId) -> Deps {
         self.deps[id.index()]
+    }
+
+    /// The variables node `id` depends on, sorted (computed once per node, on demand).
+    /// Structural: a variable is in the set when a leaf of the node's subgraph is that
+    /// variable, so `∂e/∂v` is the constant 0 (in a canonical graph) when `v` is absent.
+    pub fn var_set(&mut self, id: ExprId) -> VarSet {
+        if let Some(s) = &self.vars[id.index()] {
+            return s.clone();
+        }
+        // Iterative post-order over the nodes whose sets are missing.
+        let mut stack = vec![(id, false)];
+        while let Some((x, expanded)) = stack.pop() {
+            if self.vars[x.index()].is_some() {
+                continue;
+            }
+            let args = self.nodes[x.index()].args();
+            if !expanded {
+                stack.push((x, true));
+                for &a in args.iter().rev() {
+                    if self.vars[a.index()].is_none() {
+                        stack.push((a, false));
+                    }
+                }
+                continue;
+            }
+            let set: VarSet = match &self.nodes[x.index()] {
+                Node::Const(_) => Arc::from(Vec::new()),
+                Node::Var(v) => Arc::from(vec![*v]),
+                _ => {
+                    let sets: Vec<VarSet> = args
+                        .iter()
+                        .map(|a| self.vars[a.index()].clone().expect("operand's set first"))
+                        .collect();
+                    union_sets(&sets)
+                }
+            };
+            self.vars[x.index()] = Some(set);
+        }
+        self.vars[id.index()].clone().expect("set computed")
+    }
+
+    /// Whether node `id` depends on the variable `v` (see [`Graph::var_set`]).
+    pub fn depends_on(&mut self, id: ExprId, v: Var) -> bool {
+        if !self.deps(id).has(Deps::of(v)) {
+            return false;
+        }
+        self.var_set(id).binary_search(&v).is_ok()
     }
 
     /// Number of nodes.
@@ -208,6 +312,8 @@ impl Graph {
         let id = ExprId(u32::try_from(self.nodes.len()).expect("expression graph too large"));
         self.nodes.push(node.clone());
         self.deps.push(deps);
+        self.vars.push(None);
+        self.primed.push(0);
         self.lookup.insert(node, id);
         id
     }

@@ -172,15 +172,30 @@ impl Func {
 /// The partial derivatives of node `id` with respect to each of its operands, in operand
 /// order: `∂node/∂arg_k`. Leaves have no operands.
 pub fn partials(g: &mut Graph, id: ExprId) -> Vec<(ExprId, ExprId)> {
+    partials_where(g, id, &|_| true)
+}
+
+/// The partials of [`partials`] for the operands `k` with `keep(k)` only, in order.
+/// Sums and products build only those; other operations (at most two operands) build
+/// all of them.
+pub fn partials_where(
+    g: &mut Graph,
+    id: ExprId,
+    keep: &dyn Fn(usize) -> bool,
+) -> Vec<(ExprId, ExprId)> {
     let node = g.node(id).clone();
     match node {
         Node::Const(_) | Node::Var(_) => Vec::new(),
         Node::Add(terms) => {
             let one = g.constant(1.0);
-            terms.iter().map(|&a| (a, one)).collect()
+            (0..terms.len())
+                .filter(|&k| keep(k))
+                .map(|k| (terms[k], one))
+                .collect()
         }
         // ∂(Π a_j)/∂a_k = Π_{j≠k} a_j
         Node::Mul(factors) => (0..factors.len())
+            .filter(|&k| keep(k))
             .map(|k| {
                 let others: Vec<ExprId> = factors
                     .iter()

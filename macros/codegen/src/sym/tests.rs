@@ -2,7 +2,7 @@
 //! constructors, and random expressions whose simplified and unsimplified forms (and
 //! derivatives) must evaluate equal.
 
-use super::transform::{eval, rebuild};
+use super::transform::{self, eval, rebuild};
 use super::*;
 
 /// splitmix64, seeded: reproducible random numbers without a dependency.
@@ -319,4 +319,98 @@ fn integer_exponents_never_wrap() {
         at(&g, d2, 1.0),
         f64::from(i32::MAX) * (f64::from(i32::MAX) + 1.0)
     );
+}
+
+/// The variables among the leaves of `e`, by a plain walk.
+fn leaves(g: &Graph, e: ExprId) -> Vec<Var> {
+    let mut vs: Vec<Var> = transform::post_order(g, &[e])
+        .into_iter()
+        .filter_map(|id| match g.node(id) {
+            Node::Var(v) => Some(*v),
+            _ => None,
+        })
+        .collect();
+    vs.sort();
+    vs.dedup();
+    vs
+}
+
+/// A random expression over a wide pool of coordinates and velocities, so that most
+/// variables are absent from most nodes (as in a long chain of bodies).
+fn sparse_expr(g: &mut Graph, rng: &mut Rng) -> ExprId {
+    let e = random_expr(g, rng, 4);
+    let base = 2 * rng.below(6) as u32;
+    transform::substitute(g, e, &mut |g, v| match v {
+        Var::Q(i) => Some(g.var(Var::Q(base + i))),
+        Var::Qd(i) => Some(g.var(Var::Qd(base + i + 1))),
+        _ => None,
+    })
+}
+
+#[test]
+fn variable_sets_hold_exactly_the_leaves() {
+    let mut rng = Rng(0x5E7);
+    let mut g = Graph::new();
+    let roots: Vec<ExprId> = (0..200).map(|_| sparse_expr(&mut g, &mut rng)).collect();
+    let sum = g.add(roots.clone());
+    for id in (0..g.len()).map(ExprId::from_index) {
+        let set = g.var_set(id);
+        assert_eq!(&*set, leaves(&g, id).as_slice(), "node {id:?}");
+        for v in [Var::Time, Var::Q(3), Var::Qd(4), Var::Param(0)] {
+            assert_eq!(g.depends_on(id, v), set.contains(&v), "{v:?} in {id:?}");
+        }
+    }
+    assert!(g.var_set(sum).len() > 10, "the sum spans the pool");
+    // `2 + x` and `x²` share the set of `x` instead of copying it.
+    let x = g.var(Var::Q(7));
+    let two = g.constant(2.0);
+    let s = g.add(vec![two, x]);
+    let p = g.powi(x, 2);
+    let (sx, ss, sp) = (g.var_set(x), g.var_set(s), g.var_set(p));
+    assert!(std::sync::Arc::ptr_eq(&sx, &ss) && std::sync::Arc::ptr_eq(&sx, &sp));
+    assert!(g.var_set(two).is_empty());
+}
+
+#[test]
+fn skipping_absent_variables_builds_the_graph_of_the_full_walk() {
+    // The same random derivation in a graph that skips absent variables and in one that
+    // walks every node of the variable's kind: node for node the same graph, and the
+    // same results, whatever the order of the variables.
+    let run = |mut g: Graph| {
+        let mut rng = Rng(0xF011);
+        let mut out = Vec::new();
+        let roots: Vec<ExprId> = (0..60).map(|_| sparse_expr(&mut g, &mut rng)).collect();
+        let pairs: Vec<(Var, ExprId)> = (0..14).map(|i| (Var::Q(i), g.var(Var::Qd(i)))).collect();
+        for (k, &r) in roots.iter().enumerate() {
+            for _ in 0..6 {
+                let v = match rng.below(3) {
+                    0 => Var::Q(rng.below(14) as u32),
+                    1 => Var::Qd(rng.below(14) as u32),
+                    _ => Var::Time,
+                };
+                let d = diff::differentiate(&mut g, r, v);
+                out.push(diff::differentiate(&mut g, d, Var::Q(rng.below(14) as u32)));
+            }
+            let kind = if k % 2 == 0 { Var::Q } else { Var::Qd };
+            let mut rates = Vec::new();
+            diff::for_each_partial(&mut g, r, 14, kind, &mut |g, j, d| {
+                rates.push(g.mul(vec![d, pairs[j as usize].1]));
+                out.push(d);
+            });
+            out.extend(rates);
+            out.push(diff::directional(&mut g, r, &pairs));
+        }
+        let nodes: Vec<Node> = (0..g.len())
+            .map(|i| g.node(ExprId::from_index(i)).clone())
+            .collect();
+        (nodes, out)
+    };
+    let (skip_nodes, skip_out) = run(Graph::new());
+    let (full_nodes, full_out) = run(Graph::full_walk());
+    assert_eq!(skip_out, full_out);
+    assert_eq!(skip_nodes.len(), full_nodes.len());
+    assert!(skip_nodes == full_nodes, "the graphs differ");
+    assert!(skip_out
+        .iter()
+        .any(|&e| !matches!(skip_nodes[e.index()], Node::Const(_))));
 }
