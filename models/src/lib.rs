@@ -46,6 +46,8 @@ mod bicycle_model;
 mod body_impact_model;
 #[path = "bouncing_ball.rs"]
 mod bouncing_ball_model;
+#[path = "bricard.rs"]
+mod bricard_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
 #[path = "falling_rod.rs"]
@@ -83,6 +85,7 @@ pub use andrews_model::andrews;
 pub use bicycle_model::bicycle;
 pub use body_impact_model::{body_impact, two_body_impact};
 pub use bouncing_ball_model::bouncing_ball;
+pub use bricard_model::bricard;
 pub use car_axis_model::car_axis;
 pub use falling_rod_model::falling_rod;
 pub use free_body_model::free_body;
@@ -151,6 +154,11 @@ static ALL: &[Entry] = &[
         name: "spatial_four_bar",
         summary: "spatial four-bar (revolute, spherical, universal) with Euler parameters",
         make: || Box::new(spatial_four_bar::Model::default()),
+    },
+    Entry {
+        name: "bricard",
+        summary: "Bricard's overconstrained 6R loop, rank-deficient everywhere (IFToMM A04)",
+        make: || Box::new(bricard::Model::default()),
     },
     Entry {
         name: "andrews",

@@ -340,6 +340,7 @@ impl Kinematics {
             });
         }
         let mut step = f64::INFINITY;
+        let mut previous = residual;
         for iteration in 1..=params.newton.max_iterations {
             if iteration > 1 {
                 ws.eval_jacobian(mech, t, q)?;
@@ -376,7 +377,12 @@ impl Kinematics {
                 history.push(residual);
             }
             // The row norms of the last C_q (one update old) scale the residual test.
-            if step <= tol * scale::coordinate_size(q) && met(ws, q) {
+            // Stagnation at the rounding floor also ends the iteration (see
+            // `scale::at_rounding_floor`).
+            let stagnant = residual >= 0.5 * previous
+                && scale::at_rounding_floor(&ws.c, &ws.jacobian, n, scale::coordinate_size(q));
+            previous = residual;
+            if (step <= tol * scale::coordinate_size(q) && met(ws, q)) || stagnant {
                 return Ok(NewtonStats {
                     iterations: iteration,
                     residual,

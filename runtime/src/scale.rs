@@ -51,6 +51,21 @@ pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, siz
     unmet(c, jacobian, n, tolerance, size).next().is_none()
 }
 
+/// Whether every constraint of `c` is within its rounding floor
+/// $64\,\varepsilon\,\lVert (C_q)_i\rVert_\infty \max(s_q, 1)$.
+///
+/// The relative test of [`all_met`] asks for a distance within $\varepsilon s_q$ of the
+/// surface; when the coordinates are all near zero (a linkage whose joint angles start
+/// at 0) that is below what evaluating $C$ can resolve, since the rounding of $C$
+/// follows the size of the geometry, not of $q$. Newton then stagnates at this floor.
+/// A Newton iteration whose residual has stopped falling accepts the point when this
+/// holds; the unit scale is a floor for angles (1 rad) that only applies after
+/// stagnation, where further iterations cannot improve the point.
+pub(crate) fn at_rounding_floor(c: &[f64], jacobian: &[f64], n: usize, size: f64) -> bool {
+    let floor = 64.0 * f64::EPSILON;
+    all_met(c, jacobian, n, floor, size.max(1.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,6 +83,18 @@ mod tests {
             assert!(all_met(&c, &jacobian, 2, 1e-12, size), "l = {l}");
             assert!(!all_met(&c, &jacobian, 2, 1e-14, size), "l = {l}");
         }
+    }
+
+    /// Near q = 0 the relative test cannot be met at round-off, the floor can; a
+    /// residual far above round-off is not at the floor.
+    #[test]
+    fn the_rounding_floor_holds_where_the_size_of_q_gives_none() {
+        let (q, jacobian) = ([1e-6, 0.0], [1.0, 0.5]);
+        let size = coordinate_size(&q);
+        let c = [2e-16];
+        assert!(!all_met(&c, &jacobian, 2, 1e-14, size));
+        assert!(at_rounding_floor(&c, &jacobian, 2, size));
+        assert!(!at_rounding_floor(&[1e-10], &jacobian, 2, size));
     }
 
     #[test]

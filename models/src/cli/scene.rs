@@ -156,6 +156,12 @@ impl Scene {
                 steady: None,
                 closed_form: None,
             },
+            "bricard" => Self {
+                t_end: 10.0,
+                span: "the 10 s of the IFToMM A04 benchmark",
+                steady: None,
+                closed_form: None,
+            },
             "seed2_example1" => Self {
                 t_end: 2.0,
                 span: "the span of math-spec V2",

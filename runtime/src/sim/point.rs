@@ -400,13 +400,19 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let mut refitted = false;
         if self.rows_h > 0 {
             let mut iterations = 0;
+            let mut previous = f64::INFINITY;
             loop {
                 let residual = inf_norm(self.constraints(t).map_err(eval)?);
                 self.dense_jacobian(t).map_err(eval)?;
                 let size = scale::coordinate_size(&self.q);
-                if scale::all_met(self.ws.constraints(), self.ws.jacobian(), n, tol, size) {
+                let (c, jac) = (self.ws.constraints(), self.ws.jacobian());
+                // Met, or stagnant at the rounding floor (`scale::at_rounding_floor`).
+                if scale::all_met(c, jac, n, tol, size)
+                    || (residual >= 0.5 * previous && scale::at_rounding_floor(c, jac, n, size))
+                {
                     break;
                 }
+                previous = residual;
                 let stalled = iterations == self.newton.max_iterations || !residual.is_finite();
                 if stalled && !refitted && self.refit(t) {
                     (refitted, iterations) = (true, 0);

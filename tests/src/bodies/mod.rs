@@ -1,6 +1,7 @@
 //! The body level of `#[mechanism]`: agreement with hand-written models, the Euler-parameter
 //! free body (math-spec V12), and every joint type against finite differences.
 
+mod bricard;
 mod drawing;
 mod joints;
 mod masses;
