@@ -18,6 +18,7 @@
 //! | [`slider_crank_bodies`] | as `slider_crank`, from bodies and joints | 9 holonomic |
 //! | [`sleigh_bodies`] | as `sleigh`, from a body and a knife edge | 1 non-holonomic |
 //! | [`free_body`] | `x y z e0 e1 e2 e3` | 1 holonomic (Euler-parameter normalization) |
+//! | [`chain10`] | `xi yi zi e0_i … e3_i`, `i = 1 … 10` | 40 holonomic (10 ball joints, 10 normalizations) |
 //! | [`bouncing_ball`] | `y` | 1 contact |
 //! | [`falling_rod`] | `x y phi` | 2 contacts |
 //! | [`pendulum_floor`] | `x1 y1 phi1 x2 y2 phi2` | 4 holonomic, 1 contact (math-spec V15) |
@@ -50,8 +51,16 @@ mod bouncing_ball_model;
 mod bricard_model;
 #[path = "car_axis.rs"]
 mod car_axis_model;
+/// The spatial N-link chain's source for any `N` (the template of `chain10`, which the
+/// build script writes into `OUT_DIR`).
+#[path = "chain/source.rs"]
+pub mod chain;
 #[path = "falling_rod.rs"]
 mod falling_rod_model;
+/// `chain10`, generated from [`chain::chain_source`] by the build script.
+mod chain_models {
+    include!(concat!(env!("OUT_DIR"), "/chain10.rs"));
+}
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -87,6 +96,7 @@ pub use body_impact_model::{body_impact, two_body_impact};
 pub use bouncing_ball_model::bouncing_ball;
 pub use bricard_model::bricard;
 pub use car_axis_model::car_axis;
+pub use chain_models::chain10;
 pub use falling_rod_model::falling_rod;
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
@@ -224,6 +234,11 @@ static ALL: &[Entry] = &[
         name: "newtons_cradle",
         summary: "Newton's cradle, three balls on strings (sequential impacts)",
         make: || Box::new(newtons_cradle::Model::default()),
+    },
+    Entry {
+        name: "chain10",
+        summary: "spatial chain of 10 rods on ball joints, Euler parameters (scaling, n = 70)",
+        make: || Box::new(chain10::Model::default()),
     },
 ];
 

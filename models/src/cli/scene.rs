@@ -74,6 +74,18 @@ impl Scene {
                 }),
                 closed_form: Some(pendulum_exact),
             },
+            "chain10" => Self {
+                t_end: 0.5,
+                span: "the first swing down from the horizontal",
+                steady: None,
+                closed_form: None,
+            },
+            "chain100" => Self {
+                t_end: 0.01,
+                span: "a short span: 700 coordinates and 400 constraints per step",
+                steady: None,
+                closed_form: None,
+            },
             "slider_crank" => Self {
                 t_end: std::f64::consts::TAU / 10.0,
                 span: "one crank revolution",
