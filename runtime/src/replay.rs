@@ -170,7 +170,9 @@ pub struct Event {
     /// When.
     pub t: f64,
     /// What: `repartition` (the independent coordinates were chosen anew), `impact`
-    /// (a contact closed), or a kind added later.
+    /// (a contact struck; `name` the contacts, `detail` the normal velocities and the
+    /// energy lost), `rest` (a contact came to rest after accumulated impacts),
+    /// `release` (a resting contact opened), or a kind added later.
     pub kind: String,
     /// What it concerns (a contact's name), when it concerns something named.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -330,6 +332,90 @@ pub fn decimate(times: &[f64], n: usize) -> Vec<usize> {
     out
 }
 
+/// A sample of a replay: a row of the trajectory, or a state `(t, q, q̇)` of its own.
+#[derive(Clone, Copy)]
+enum Sample<'a> {
+    Row(usize),
+    State(f64, &'a [f64], &'a [f64]),
+}
+
+/// `rows` (increasing) with, for each of `times`, the rows at that time (an impact
+/// records the state before and after at one time) or else the nearest one, so that a
+/// decimated replay shows the moment of each event.
+#[must_use]
+pub fn keep_rows_at(all: &[f64], mut rows: Vec<usize>, times: &[f64]) -> Vec<usize> {
+    if all.is_empty() {
+        return rows;
+    }
+    for &t in times {
+        let i = all.partition_point(|&x| x < t);
+        let mut j = i;
+        while j < all.len() && all[j] == t {
+            rows.push(j);
+            j += 1;
+        }
+        if j == i {
+            let near = match i {
+                0 => 0,
+                _ if i == all.len() => i - 1,
+                _ if all[i] - t < t - all[i - 1] => i,
+                _ => i - 1,
+            };
+            rows.push(near);
+        }
+    }
+    rows.sort_unstable();
+    rows.dedup();
+    rows
+}
+
+/// The events of a run, in time order.
+fn events_of(run: &Run) -> Vec<Event> {
+    let mut events: Vec<Event> = run
+        .repartition_times
+        .iter()
+        .map(|&t| Event {
+            t,
+            kind: "repartition".to_owned(),
+            name: None,
+            detail: None,
+        })
+        .collect();
+    for imp in &run.impacts {
+        events.push(Event {
+            t: imp.t,
+            kind: "impact".to_owned(),
+            name: Some(imp.names.join(", ")),
+            detail: Some(format!(
+                "normal velocity {} -> {}, kinetic energy lost {:.3e}",
+                join(&imp.normal_velocity_before),
+                join(&imp.normal_velocity_after),
+                imp.energy_lost()
+            )),
+        });
+    }
+    for c in &run.contact_events {
+        events.push(Event {
+            t: c.t,
+            kind: match c.kind {
+                crate::sim::ContactEventKind::Rest => "rest",
+                crate::sim::ContactEventKind::Release => "release",
+            }
+            .to_owned(),
+            name: Some(c.contact.to_owned()),
+            detail: None,
+        });
+    }
+    // Stable: the order of the run among events at one time.
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    events
+}
+
+fn join(v: &[f64]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| format!("{x:.4e}")).collect();
+    parts.join(", ")
+}
+
 /// `x` with `digits` significant digits.
 fn round(x: f64, digits: Option<u32>) -> f64 {
     match digits {
@@ -366,10 +452,44 @@ impl Replay {
     ) -> Replay {
         let info = model.info();
         let tr = &run.trajectory;
+        let events = events_of(run);
         let rows = match (tr.t.first(), tr.t.last()) {
-            (Some(&a), Some(&b)) => decimate(&tr.t, opts.samples(a, b)),
+            (Some(&a), Some(&b)) => {
+                // Many events (a chattering contact) are marks only, not samples.
+                // Impacts are samples of their own (below).
+                let times: Vec<f64> = if events.len() <= opts.max_samples / 10 {
+                    events
+                        .iter()
+                        .filter(|e| e.kind != "impact")
+                        .map(|e| e.t)
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                keep_rows_at(&tr.t, decimate(&tr.t, opts.samples(a, b)), &times)
+            }
             _ => Vec::new(),
         };
+        // The samples: the rows, and the states just before and after each impact (the
+        // rows rarely fall on one); rows at an impact's time are left out, since which
+        // side of the jump they hold is not recorded.
+        let mut samples: Vec<Sample<'_>> = rows
+            .into_iter()
+            .filter(|&i| !run.impacts.iter().any(|imp| imp.t == tr.t[i]))
+            .map(Sample::Row)
+            .collect();
+        if run.impacts.len() <= opts.max_samples / 10 {
+            for imp in &run.impacts {
+                samples.push(Sample::State(imp.t, &imp.q, &imp.qd_before));
+                samples.push(Sample::State(imp.t, &imp.q, &imp.qd_after));
+            }
+        }
+        let time = |s: &Sample<'_>| match *s {
+            Sample::Row(i) => tr.t[i],
+            Sample::State(t, _, _) => t,
+        };
+        samples.sort_by(|a, b| time(a).total_cmp(&time(b)));
+        let rows = samples;
         let r = |x: f64| round(x, opts.digits);
         let drawing = model.drawing();
         let (nf, np) = (info.frames.len(), info.points.len());
@@ -426,12 +546,28 @@ impl Replay {
         let mut energy = Vec::with_capacity(rows.len());
         let mut violation = Violations::default();
         let mut scalars = vec![0.0; drawing.scalars as usize];
-        for (k, &i) in rows.iter().enumerate() {
-            let (t, q, qd) = (tr.t[i], tr.q(i), tr.qd(i));
+        for (k, sample) in rows.iter().enumerate() {
+            let (t, q, qd, recorded) = match *sample {
+                Sample::Row(i) => (
+                    tr.t[i],
+                    tr.q(i),
+                    tr.qd(i),
+                    Some((
+                        tr.energy(i),
+                        tr.position_violation[i],
+                        tr.velocity_violation[i],
+                    )),
+                ),
+                Sample::State(t, q, qd) => (t, q, qd, None),
+            };
+            let (e, vp, vv) = recorded.unwrap_or_else(|| {
+                let res = model.residuals(t, q, qd);
+                (None, res.position, res.velocity.max(res.nonholonomic))
+            });
             times.push(t);
-            energy.push(r(tr.energy(i).unwrap_or_else(|| model.energy(t, q, qd))));
-            violation.position.push(r(tr.position_violation[i]));
-            violation.velocity.push(r(tr.velocity_violation[i]));
+            energy.push(r(e.unwrap_or_else(|| model.energy(t, q, qd))));
+            violation.position.push(r(vp));
+            violation.velocity.push(r(vv));
             for (s, &v) in coordinates.iter_mut().zip(q) {
                 s.values.push(r(v));
             }
@@ -488,17 +624,6 @@ impl Replay {
                 && draw_points
                     .iter()
                     .any(|p| p.position.chunks_exact(3).any(|v| v[2] != 0.0)));
-        let mut events: Vec<Event> = run
-            .repartition_times
-            .iter()
-            .map(|&t| Event {
-                t,
-                kind: "repartition".to_owned(),
-                name: None,
-                detail: None,
-            })
-            .collect();
-        events.sort_by(|a, b| a.t.total_cmp(&b.t));
         Replay {
             format: FORMAT.to_owned(),
             version: VERSION,
@@ -701,6 +826,18 @@ mod tests {
         assert_eq!(opts.samples(0.0, 1.0), 600);
         assert_eq!(opts.samples(0.0, 10.0), 2400);
         assert_eq!(opts.samples(0.0, 1e6), 6000);
+    }
+
+    #[test]
+    fn event_rows_are_kept() {
+        let times = [0.0, 0.1, 0.2, 0.25, 0.25, 0.3, 0.4];
+        // Both rows at 0.25 (before and after an impact), the nearest row to 0.37.
+        assert_eq!(
+            keep_rows_at(&times, vec![0, 2, 6], &[0.25, 0.37]),
+            vec![0, 2, 3, 4, 6]
+        );
+        assert_eq!(keep_rows_at(&times, vec![0, 6], &[-1.0, 9.0]), vec![0, 6]);
+        assert_eq!(keep_rows_at(&[], vec![], &[1.0]), Vec::<usize>::new());
     }
 
     #[test]

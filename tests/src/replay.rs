@@ -108,3 +108,56 @@ fn bad_files_are_refused() {
         Err(ReplayError::Json(_))
     ));
 }
+
+/// The bouncing ball's impacts become `impact` events (then `rest` when they have
+/// accumulated), each kept as samples: at an impact's time the replay holds the rows
+/// before and after, the drawn ball (a disc of radius 0.05 h resting on its lowest
+/// point, the gap `y`) touches the floor there, and the energy drops across it (e = 0.5
+/// keeps a quarter of the kinetic energy).
+#[test]
+fn impacts_are_events_and_samples() {
+    use pfaff_models::bouncing_ball;
+    let model = bouncing_ball::Model::default();
+    let run = Simulation::new(&model)
+        .integrator(Method::Dop853)
+        .tolerances(1e-10, 1e-12)
+        .output_every(0.001)
+        .run(2.0)
+        .expect("the ball bounces");
+    assert!(run.impacts.len() >= 3, "{} impacts", run.impacts.len());
+    let replay = Replay::from_run(&model, &run, Map::new(), &ReplayOptions::default());
+    let impacts: Vec<&Event> = replay
+        .events
+        .iter()
+        .filter(|e| e.kind == "impact")
+        .collect();
+    assert_eq!(impacts.len(), run.impacts.len());
+    assert!(replay.events.iter().any(|e| e.kind == "rest"));
+    let first = impacts[0];
+    assert_eq!(first.t, run.impacts[0].t);
+    assert_eq!(first.name.as_deref(), Some("floor"));
+    let at: Vec<usize> = (0..replay.len())
+        .filter(|&k| replay.times[k] == first.t)
+        .collect();
+    assert_eq!(at.len(), 2, "the states before and after the first impact");
+    let (before, after) = (replay.energy[at[0]], replay.energy[at[1]]);
+    let mgh = 9.81;
+    // Closed form: all of m g h is kinetic at the floor; a quarter of it remains.
+    assert!(
+        (before - mgh).abs() < 1e-6 && (after - 0.25 * mgh).abs() < 1e-6,
+        "{before} {after}"
+    );
+    let disc = replay
+        .drawing
+        .shapes
+        .iter()
+        .find(|s| s.kind == "disc")
+        .expect("the ball");
+    let r = disc.radius.expect("a radius");
+    let centre = &replay.drawing.points[disc.points[0]].position;
+    let k = at[0];
+    assert!(
+        (centre[3 * k + 1] - r).abs() < 1e-9,
+        "the ball touches the floor"
+    );
+}
