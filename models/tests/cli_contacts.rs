@@ -68,3 +68,25 @@ fn simulate_reports_impacts() {
     let text = stdout(&pfaff(&["simulate", "pendulum"]));
     assert!(!text.contains("impacts"), "{text}");
 }
+
+/// `work-precision` on the impact models compares the final state after the impacts
+/// with the closed forms (scene.rs): every adaptive method at rtol 1e-8 is within 1e-6.
+#[test]
+fn work_precision_on_impact_models() {
+    for model in ["bouncing_ball", "falling_rod"] {
+        let out = pfaff(&["work-precision", model]);
+        assert!(out.status.success(), "{model}");
+        let text = stdout(&out);
+        assert!(text.contains("the closed-form solution"), "{text}");
+        let mut checked = 0;
+        for line in text.lines() {
+            let cols: Vec<&str> = line.split_whitespace().collect();
+            if cols.len() >= 4 && cols[1] != "rk4" && cols[2] == "1e-8" {
+                let err: f64 = cols[3].parse().unwrap();
+                assert!(err < 1e-6, "{model}: {line}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 9, "{model}: {checked} rows at 1e-8 in\n{text}");
+    }
+}

@@ -474,6 +474,8 @@ fn handle_in<M: Mechanism + ?Sized>(
     // The sequential law: the closed contact approaching fastest strikes alone, until
     // none approaches.
     let mut threshold = None;
+    // Contacts struck in this event whose own rebound was negligible.
+    let mut dead = [false; 64];
     for _ in 0..64 * nc {
         let p = &mut sys.point;
         c.gaps_at(mech, t, &p.q)?;
@@ -501,6 +503,9 @@ fn handle_in<M: Mechanism + ?Sized>(
         p.invalidate();
         c.v_ref[k] = c.v_ref[k].max(-c.vn[k]);
         c.opened[k] = false;
+        if let Some(d) = dead.get_mut(k) {
+            *d = impact.normal_velocity_after[0].abs() <= REST_RATIO * c.v_ref[k];
+        }
         forced = None;
         c.impacts.push(impact);
     }
@@ -517,8 +522,12 @@ fn handle_in<M: Mechanism + ?Sized>(
         if c.resting[k] || c.g[k] > eps && sinking != Some(k) {
             continue;
         }
-        let slow = c.vn[k].abs() <= (REST_RATIO * c.v_ref[k]).max(v_floor);
-        if slow || sinking == Some(k) {
+        // A rebound below the rest ratio, a contact that sank, or at the start a closed
+        // contact without normal velocity. (A contact left at rest by another strike,
+        // like the balls of a cradle, is not one.)
+        let rebound = dead.get(k).copied().unwrap_or(false);
+        let at_start = found.is_none() && c.vn[k].abs() <= v_floor;
+        if rebound || at_start || sinking == Some(k) {
             candidates.push(k);
         }
     }
@@ -531,10 +540,11 @@ fn handle_in<M: Mechanism + ?Sized>(
         loop {
             sys.form.accelerations(&mut sys.point, t)?;
             c.correct(&mut sys.point, t)?;
+            let floor = 1e-9 * (1.0 + inf_norm(sys.point.ws.forces()));
             let Some(k) = candidates
                 .iter()
                 .copied()
-                .filter(|&k| c.resting[k] && c.nu[k] <= 0.0)
+                .filter(|&k| c.resting[k] && c.nu[k] <= floor)
                 .min_by(|&a, &b| c.nu[a].total_cmp(&c.nu[b]))
             else {
                 break;

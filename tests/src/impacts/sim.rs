@@ -265,3 +265,32 @@ fn bouncing_ball_with_rk4() {
         );
     }
 }
+
+/// The sleigh starts at V16's impact instant: inside a run, with every integrator and
+/// formulation, the first row is after the jump (q̇⁺ of V16, G q̇⁺ = 0), and each impact
+/// restarts the integrator (the Adams method from order 1).
+#[test]
+fn sleigh_wall_impact_inside_a_run() {
+    let model = pfaff_models::sleigh_wall::Model::default();
+    for f in formulations() {
+        for m in methods() {
+            let r = run(&model, f, m, 1.0);
+            let imp = &r.impacts[0];
+            assert_eq!(imp.t, 0.0);
+            assert!((imp.impulses[0] - 1.370_464_752_9).abs() < 1e-9);
+            assert!((imp.constraint_impulses[0] + 0.566_061_528_4).abs() < 1e-9);
+            let qd0 = r.trajectory.qd(0);
+            for (a, b) in qd0
+                .iter()
+                .zip([-0.035_722_354_8, 0.875_015_642_4, 2.585_489_841_4])
+            {
+                assert!((a - b).abs() < 1e-9, "{f:?} {m:?}: {qd0:?}");
+            }
+            if f != Formulation::Unconstrained {
+                // (M q̈ = Q alone does not enforce the blade.)
+                assert!(r.monitors.max_nonholonomic_violation < 1e-8, "{f:?} {m:?}");
+            }
+            assert!(r.stats.restarts as usize >= r.impacts.len() - 1);
+        }
+    }
+}
