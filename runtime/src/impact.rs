@@ -445,45 +445,12 @@ impl ImpactSolver {
         crate::workspace::check_state(self.info, t, q, Some(qd))?;
         self.evaluate(mech, t, q, contacts)?;
         let info = self.info;
-        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
-        let dim = n + m + nc;
+        let (n, m) = (info.nq(), info.nh() + info.nnh());
         let vn: Vec<f64> = contacts
             .iter()
             .map(|&c| self.rate[c] + dot(&self.d[c * n..(c + 1) * n], qd))
             .collect();
-        {
-            let jac = self.ws.jacobian();
-            let mut a = self.lu.matrix_mut();
-            for i in 0..dim {
-                for j in 0..dim {
-                    a[(i, j)] = 0.0;
-                }
-            }
-            for i in 0..n {
-                for j in 0..n {
-                    a[(i, j)] = self.mass[i * n + j];
-                }
-            }
-            for r in 0..m {
-                for j in 0..n {
-                    let v = jac[r * n + j];
-                    a[(n + r, j)] = v;
-                    a[(j, n + r)] = v;
-                }
-            }
-            // Contacts that do not strike keep an identity row: their impulse is 0.
-            for c in 0..nc {
-                if contacts.contains(&c) {
-                    for j in 0..n {
-                        let v = self.d[c * n + j];
-                        a[(n + m + c, j)] = v;
-                        a[(j, n + m + c)] = -v;
-                    }
-                } else {
-                    a[(n + m + c, n + m + c)] = 1.0;
-                }
-            }
-        }
+        self.fill_augmented(|c| contacts.contains(&c));
         let ratio = self.lu.factor().ratio();
         if ratio < MASS_TOLERANCE {
             return Err(ImpactError::SingularMass { t, ratio });
@@ -650,45 +617,13 @@ impl ImpactSolver {
         active: &[bool],
     ) -> Result<(), ImpactError> {
         let info = self.info;
-        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
-        let dim = n + m + nc;
+        let (n, nc) = (info.nq(), info.ncontacts());
         mech.mass_matrix(t, q, &mut self.mass_values);
         check_finite(Quantity::MassMatrix, t, &self.mass_values)?;
         scatter_row_major(info.mass_pattern, &self.mass_values, n, &mut self.mass);
         self.ws.eval_jacobian(mech, t, q)?;
         self.eval_contacts(mech, t, q)?;
-        {
-            let jac = self.ws.jacobian();
-            let mut a = self.lu.matrix_mut();
-            for i in 0..dim {
-                for j in 0..dim {
-                    a[(i, j)] = 0.0;
-                }
-            }
-            for i in 0..n {
-                for j in 0..n {
-                    a[(i, j)] = self.mass[i * n + j];
-                }
-            }
-            for r in 0..m {
-                for j in 0..n {
-                    let v = jac[r * n + j];
-                    a[(n + r, j)] = v;
-                    a[(j, n + r)] = v;
-                }
-            }
-            for c in 0..nc {
-                if active[c] {
-                    for j in 0..n {
-                        let v = self.d[c * n + j];
-                        a[(n + m + c, j)] = v;
-                        a[(j, n + m + c)] = -v;
-                    }
-                } else {
-                    a[(n + m + c, n + m + c)] = 1.0;
-                }
-            }
-        }
+        self.fill_augmented(|c| active[c]);
         let ratio = self.lu.factor().ratio();
         if ratio < MASS_TOLERANCE {
             let contacts: Vec<usize> = (0..nc).filter(|&c| active[c]).collect();
@@ -696,6 +631,46 @@ impl ImpactSolver {
             return Err(ImpactError::SingularMass { t, ratio });
         }
         Ok(())
+    }
+
+    /// Writes the augmented matrix $[M\ {-D^\mathsf{T}}\ J^\mathsf{T}; J; D]$ of the
+    /// impulse and resting-contact solves into `lu`, from the mass matrix, $J$ in the
+    /// workspace and $D$ already evaluated; a contact for which `takes_part` is false
+    /// keeps an identity row, so its unknown is 0.
+    fn fill_augmented(&mut self, takes_part: impl Fn(usize) -> bool) {
+        let info = self.info;
+        let (n, m, nc) = (info.nq(), info.nh() + info.nnh(), info.ncontacts());
+        let dim = n + m + nc;
+        let jac = self.ws.jacobian();
+        let mut a = self.lu.matrix_mut();
+        for i in 0..dim {
+            for j in 0..dim {
+                a[(i, j)] = 0.0;
+            }
+        }
+        for i in 0..n {
+            for j in 0..n {
+                a[(i, j)] = self.mass[i * n + j];
+            }
+        }
+        for r in 0..m {
+            for j in 0..n {
+                let v = jac[r * n + j];
+                a[(n + r, j)] = v;
+                a[(j, n + r)] = v;
+            }
+        }
+        for c in 0..nc {
+            if takes_part(c) {
+                for j in 0..n {
+                    let v = self.d[c * n + j];
+                    a[(n + m + c, j)] = v;
+                    a[(j, n + m + c)] = -v;
+                }
+            } else {
+                a[(n + m + c, n + m + c)] = 1.0;
+            }
+        }
     }
 
     /// Resting contact: corrects the accelerations `qdd` and multipliers `lambda` of
