@@ -21,6 +21,7 @@ mod checks;
 pub mod contacts;
 pub mod drawing;
 pub mod free_motion;
+pub mod integrate;
 pub mod linear;
 
 use crate::ctxt::Ctxt;
