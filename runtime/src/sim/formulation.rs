@@ -94,12 +94,17 @@ fn copy_state<M: Mechanism + ?Sized>(p: &mut Point<'_, M>, y: &[f64]) {
 /// The chart's Newton converges to the intersection of the normal space through the
 /// prediction with the manifold nearest to it; a correction larger than the move from
 /// the last accepted state means it went to another one (the mirror assembly of a
-/// loop), so the evaluation fails, recoverably.
+/// loop), so the evaluation fails, recoverably. The move counts the time elapsed at the
+/// accepted speed: a rheonomic constraint moves the manifold under a prediction that
+/// has not moved yet (an implicit method's first stage iterate is the accepted state).
 #[derive(Debug)]
 pub(crate) struct Partitioned {
     chart: Chart,
     /// The last accepted positions.
     accepted: Vec<f64>,
+    /// The time and the largest velocity of the last accepted state.
+    accepted_t: f64,
+    accepted_speed: f64,
     /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
     /// before the first anchor): the reference of [`REFIT_FRACTION`].
     fit_ratio: f64,
@@ -115,6 +120,8 @@ impl Partitioned {
         Self {
             chart: Chart::new(n, m, mh, rtol, atol),
             accepted: vec![0.0; n],
+            accepted_t: 0.0,
+            accepted_speed: 0.0,
             fit_ratio: 0.0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
@@ -132,6 +139,8 @@ impl Form for Partitioned {
         t: f64,
     ) -> Result<(), SimErrorKind> {
         self.accepted.copy_from_slice(&p.q);
+        self.accepted_t = t;
+        self.accepted_speed = inf_norm(&p.qd);
         if p.rows_h == 0 {
             return Ok(());
         }
@@ -194,6 +203,7 @@ impl Form for Partitioned {
                 moved = moved.max((yj - aj).abs());
                 correction = correction.max((qj - yj).abs());
             }
+            moved += (t - self.accepted_t).abs() * self.accepted_speed;
             let scale = inf_norm(&p.q);
             let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
             if correction > moved + floor {

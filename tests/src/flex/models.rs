@@ -33,13 +33,15 @@ pub mod planar_element {
         span: 0.0..1.0,
         position: |xi| [l * xi, off],
         density: rho_a * l,
-        displacement: |xi| [
-            (1.0 - xi) * u1 + xi * u2,
-            (1.0 - 3.0 * xi * xi + 2.0 * xi.powi(3)) * v1
-                + l * (xi - 2.0 * xi * xi + xi.powi(3)) * t1
-                + (3.0 * xi * xi - 2.0 * xi.powi(3)) * v2
-                + l * (xi.powi(3) - xi * xi) * t2,
-        ],
+        displacement: |xi| {
+            [
+                (1.0 - xi) * u1 + xi * u2,
+                (1.0 - 3.0 * xi * xi + 2.0 * xi.powi(3)) * v1
+                    + l * (xi - 2.0 * xi * xi + xi.powi(3)) * t1
+                    + (3.0 * xi * xi - 2.0 * xi.powi(3)) * v2
+                    + l * (xi.powi(3) - xi * xi) * t2,
+            ]
+        },
     };
 }
 
@@ -66,11 +68,13 @@ pub mod spatial_flexible {
         span: 0.0..1.0,
         position: |s| [0.8 * s, 0.1, -0.05 + 0.2 * s],
         density: |s| 1.5 + s,
-        displacement: |s| [
-            f1 * s * s + f3 * 0.3 * s,
-            f2 * (2.0 * s).sin() + f3 * s,
-            f3 * (1.0 - s.cos()) + f1 * (0.5 * s).sinh() - f2 * s.exp() * 0.2,
-        ],
+        displacement: |s| {
+            [
+                f1 * s * s + f3 * 0.3 * s,
+                f2 * (2.0 * s).sin() + f3 * s,
+                f3 * (1.0 - s.cos()) + f1 * (0.5 * s).sinh() - f2 * s.exp() * 0.2,
+            ]
+        },
     };
 }
 

@@ -169,7 +169,9 @@ struct Invariants {
 
 fn invariants(b: &Material) -> Invariants {
     let (d, nf) = (b.dim, b.nf);
-    let i1 = (0..d).map(|k| quad(&mut |x| (b.rho)(x) * (b.pos)(x)[k])).collect();
+    let i1 = (0..d)
+        .map(|k| quad(&mut |x| (b.rho)(x) * (b.pos)(x)[k]))
+        .collect();
     let ikl = (0..d * d)
         .map(|e| quad(&mut |x| (b.rho)(x) * (b.pos)(x)[e / d] * (b.pos)(x)[e % d]))
         .collect();
@@ -226,8 +228,16 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
             for j in 0..n {
                 let s: Vec<f64> = e(i).iter().zip(e(j)).map(|(a, c)| a + c).collect();
                 let h = kinetic(&b, &q, &s) - kinetic(&b, &q, &e(i)) - kinetic(&b, &q, &e(j));
-                let want = if i == j { 2.0 * kinetic(&b, &q, &e(i)) } else { h };
-                assert!((m[i * n + j] - want).abs() < 1e-13, "M[{i},{j}] {} vs {want}", m[i * n + j]);
+                let want = if i == j {
+                    2.0 * kinetic(&b, &q, &e(i))
+                } else {
+                    h
+                };
+                assert!(
+                    (m[i * n + j] - want).abs() < 1e-13,
+                    "M[{i},{j}] {} vs {want}",
+                    m[i * n + j]
+                );
             }
         }
         // E13 with the quadrature's invariants.
@@ -240,7 +250,9 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
         let skl = |k: usize, l: usize| &inv.skl[(k * 2 + l) * nf * nf..(k * 2 + l + 1) * nf * nf];
         let ibar = |k: usize, l: usize| &inv.ibar[(k * 2 + l) * nf..(k * 2 + l + 1) * nf];
         let quadf = |s: &[f64], x: &[f64], y: &[f64]| -> f64 {
-            (0..nf).map(|i| (0..nf).map(|j| x[i] * s[i * nf + j] * y[j]).sum::<f64>()).sum()
+            (0..nf)
+                .map(|i| (0..nf).map(|j| x[i] * s[i * nf + j] * y[j]).sum::<f64>())
+                .sum()
         };
         let dotv = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
         let ukk = |k: usize| inv.ikl[k * 3] + 2.0 * dotv(ibar(k, k), qf) + quadf(skl(k, k), qf, qf);
@@ -249,7 +261,11 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
         e13[n + 1] = e13[0];
         let atuc = mat_vec(&at, 2, &uc);
         let asb: Vec<f64> = (0..2 * nf)
-            .map(|e| (0..2).map(|k| a[(e / nf) * 2 + k] * inv.sbar[k * nf + e % nf]).sum())
+            .map(|e| {
+                (0..2)
+                    .map(|k| a[(e / nf) * 2 + k] * inv.sbar[k * nf + e % nf])
+                    .sum()
+            })
             .collect();
         for r in 0..2 {
             e13[r * n + 2] = atuc[r];
@@ -260,7 +276,9 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
         e13[2 * n + 2] = ukk(0) + ukk(1);
         let (s12, s21) = (skl(0, 1), skl(1, 0));
         for j in 0..nf {
-            let qs: f64 = (0..nf).map(|i| qf[i] * (s12[i * nf + j] - s21[i * nf + j])).sum();
+            let qs: f64 = (0..nf)
+                .map(|i| qf[i] * (s12[i * nf + j] - s21[i * nf + j]))
+                .sum();
             e13[2 * n + 3 + j] = ibar(0, 1)[j] - ibar(1, 0)[j] + qs;
             for i in 0..nf {
                 e13[(3 + i) * n + 3 + j] = skl(0, 0)[i * nf + j] + skl(1, 1)[i * nf + j];
@@ -277,7 +295,11 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
         model.forces(0.0, &q, &qd, &mut qv);
         let reference = qv_reference(&b, &q, &qd, 1e-5);
         let scale = max_abs(&reference).max(1.0);
-        assert!(max_diff(&qv, &reference) < 1e-8 * scale, "∂T/∂q − Ṁq̇: {:e}", max_diff(&qv, &reference));
+        assert!(
+            max_diff(&qv, &reference) < 1e-8 * scale,
+            "∂T/∂q − Ṁq̇: {:e}",
+            max_diff(&qv, &reference)
+        );
         // E14.
         let (w, qfd) = (qd[2], &qd[3..]);
         let mff: Vec<f64> = (0..nf * nf).map(|e| skl(0, 0)[e] + skl(1, 1)[e]).collect();
@@ -289,22 +311,43 @@ fn planar_mass_matrix_and_quadratic_velocity_vector_v6() {
             e14[r] = w * w * auc[r] - 2.0 * w * atsqd[r];
         }
         let row: Vec<f64> = (0..nf)
-            .map(|j| ibar(0, 0)[j] + ibar(1, 1)[j] + (0..nf).map(|i| qf[i] * mff[i * nf + j]).sum::<f64>())
+            .map(|j| {
+                ibar(0, 0)[j]
+                    + ibar(1, 1)[j]
+                    + (0..nf).map(|i| qf[i] * mff[i * nf + j]).sum::<f64>()
+            })
             .collect();
         e14[2] = -2.0 * w * dotv(&row, qfd);
         let coriolis: Vec<f64> = (0..nf)
-            .map(|i| -2.0 * w * (0..nf).map(|j| (s21[i * nf + j] - s12[i * nf + j]) * qfd[j]).sum::<f64>())
+            .map(|i| {
+                -2.0 * w
+                    * (0..nf)
+                        .map(|j| (s21[i * nf + j] - s12[i * nf + j]) * qfd[j])
+                        .sum::<f64>()
+            })
             .collect();
         for i in 0..nf {
             let centrifugal: f64 = (0..2)
-                .map(|k| ibar(k, k)[i] + (0..nf).map(|j| skl(k, k)[i * nf + j] * qf[j]).sum::<f64>())
+                .map(|k| {
+                    ibar(k, k)[i] + (0..nf).map(|j| skl(k, k)[i * nf + j] * qf[j]).sum::<f64>()
+                })
                 .sum();
             e14[3 + i] = w * w * centrifugal + coriolis[i];
         }
-        assert!(max_diff(&qv, &e14) < 1e-12 * scale, "E14: {:e}", max_diff(&qv, &e14));
+        assert!(
+            max_diff(&qv, &e14) < 1e-12 * scale,
+            "E14: {:e}",
+            max_diff(&qv, &e14)
+        );
         // The Coriolis term is there, and with the sign of E14: the opposite sign fails.
         let flipped: Vec<f64> = (0..n)
-            .map(|i| if i >= 3 { e14[i] - 2.0 * coriolis[i - 3] } else { e14[i] })
+            .map(|i| {
+                if i >= 3 {
+                    e14[i] - 2.0 * coriolis[i - 3]
+                } else {
+                    e14[i]
+                }
+            })
             .collect();
         assert!(max_diff(&qv, &flipped) > 1e-3 * max_abs(&coriolis));
         assert!(max_abs(&coriolis) > 1e-3);
@@ -357,7 +400,10 @@ fn element_shape_integrals_of_section_3_7() {
         for i in 0..6 {
             let coriolis = f[3 + i] - f0[3 + i];
             let want = -2.0 * ra * l / 420.0 * sis[i][j];
-            assert!((coriolis - want).abs() < 1e-13, "SᵀĨS[{i},{j}]: {coriolis} vs {want}");
+            assert!(
+                (coriolis - want).abs() < 1e-13,
+                "SᵀĨS[{i},{j}]: {coriolis} vs {want}"
+            );
         }
     }
 }
@@ -398,7 +444,10 @@ fn spatial_mass_matrix_and_quadratic_velocity_vector_v7() {
             let want = kinetic(&b, &q, &vw) - kinetic(&b, &q, &v) - kinetic(&b, &q, &w);
             let mw = mat_vec(&m, n, &w);
             let got: f64 = v.iter().zip(&mw).map(|(a, c)| a * c).sum();
-            assert!((got - want).abs() < 1e-13 * want.abs().max(1.0), "vᵀMw {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-13 * want.abs().max(1.0),
+                "vᵀMw {got} vs {want}"
+            );
         }
         let mut qv = vec![0.0; n];
         model.forces(0.0, &q, &qd, &mut qv);
@@ -410,7 +459,11 @@ fn spatial_mass_matrix_and_quadratic_velocity_vector_v7() {
         let th = &q[3..7];
         let mu: f64 = (0..4).map(|k| d[3 + k] * th[k]).sum();
         let perp: Vec<f64> = (0..4).map(|k| d[3 + k] - mu * th[k]).collect();
-        assert!(max_abs(&perp) < 1e-8 * scale, "θ rows off θ: {:e}", max_abs(&perp));
+        assert!(
+            max_abs(&perp) < 1e-8 * scale,
+            "θ rows off θ: {:e}",
+            max_abs(&perp)
+        );
     }
 }
 
@@ -440,12 +493,18 @@ fn quadratic_velocity_vector_is_the_lagrange_derivative_of_the_generated_energy(
                     let (mut a, mut c) = (q.clone(), q.clone());
                     a[i] += h;
                     c[i] -= h;
-                    let dt = (model.kinetic_energy(0.0, &a, &qd) - model.kinetic_energy(0.0, &c, &qd)) / (2.0 * h);
+                    let dt = (model.kinetic_energy(0.0, &a, &qd)
+                        - model.kinetic_energy(0.0, &c, &qd))
+                        / (2.0 * h);
                     dt - (mp[i] - mm[i]) / (2.0 * h)
                 })
                 .collect();
             let scale = max_abs(&want).max(1.0);
-            assert!(max_diff(&qv, &want) < 1e-7 * scale, "{:e}", max_diff(&qv, &want));
+            assert!(
+                max_diff(&qv, &want) < 1e-7 * scale,
+                "{:e}",
+                max_diff(&qv, &want)
+            );
         }
     }
     check(&planar_element::Model::default(), 9, 3);

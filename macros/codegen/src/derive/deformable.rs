@@ -25,6 +25,7 @@
 //! `ε = u' + ½ w'²`, i.e. the extra energy `s · ½ EA ∫ (u' w'² + ¼ w'⁴) dx`.
 
 use proc_macro2::Span;
+use syn::spanned::Spanned;
 
 use super::{fields, idx, BodyOut, Builder, Fields};
 use crate::derive::integrate::{integrate, XI};
@@ -80,16 +81,33 @@ fn closure(cx: &crate::ctxt::Ctxt, e: &syn::Expr) -> Option<Closure> {
         }
     };
     let syn::Pat::Ident(id) = pat else {
-        cx.error_spanned_by(pat, "the material coordinate is a plain name, e.g. `|xi| ..`");
+        cx.error_spanned_by(
+            pat,
+            "the material coordinate is a plain name, e.g. `|xi| ..`",
+        );
         return None;
     };
     if c.inputs.len() != 1 {
-        cx.error_spanned_by(&c.inputs, "the closure takes one argument, the material coordinate");
+        cx.error_spanned_by(
+            &c.inputs,
+            "the closure takes one argument, the material coordinate",
+        );
         return None;
+    }
+    // rustfmt writes a long closure body as a block: `|xi| { [..] }`.
+    let mut body = &*c.body;
+    while let syn::Expr::Block(b) = body {
+        match (b.block.stmts.as_slice(), &b.label) {
+            ([syn::Stmt::Expr(e, None)], None) => body = e,
+            _ => {
+                cx.error_spanned_by(body, "the closure's body is one expression (no statements)");
+                return None;
+            }
+        }
     }
     Some(Closure {
         var: id.ident.to_string(),
-        body: (*c.body).clone(),
+        body: body.clone(),
     })
 }
 
@@ -107,8 +125,15 @@ impl Builder<'_, '_> {
         Some(x)
     }
 
-    /// A nested array of the given shape (a scalar `0.0` stands for a zero block).
-    fn table(&mut self, e: &syn::Expr, shape: &[usize], out: &mut Vec<ExprId>) -> Option<()> {
+    /// A nested array of the given shape (a scalar `0.0` stands for a zero block);
+    /// `what` names the field and its dimensions, for messages.
+    fn table(
+        &mut self,
+        e: &syn::Expr,
+        shape: &[usize],
+        what: &str,
+        out: &mut Vec<ExprId>,
+    ) -> Option<()> {
         let Some((&first, rest)) = shape.split_first() else {
             out.push(self.invariant_scalar(e)?);
             return Some(());
@@ -121,20 +146,17 @@ impl Builder<'_, '_> {
                     return Some(());
                 }
             }
-            let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
             self.cx.error_spanned_by(
                 e,
-                format!("expected a {} array (or `0.0` for zeros)", dims.join(" × ")),
+                format!("{what}: expected an array of {first} entries here (or `0.0` for zeros)"),
             );
             return None;
         };
         if a.elems.len() != first {
-            let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
             self.cx.error_spanned_by(
                 e,
                 format!(
-                    "expected {first} entries here (a {} array); this has {}",
-                    dims.join(" × "),
+                    "{what}: expected {first} entries here; this has {}",
                     a.elems.len()
                 ),
             );
@@ -142,14 +164,22 @@ impl Builder<'_, '_> {
         }
         let mut ok = true;
         for x in &a.elems {
-            ok &= self.table(x, rest, out).is_some();
+            ok &= self.table(x, rest, what, out).is_some();
         }
         ok.then_some(())
     }
 
-    fn table_of(&mut self, e: &syn::Expr, shape: &[usize]) -> Option<Vec<ExprId>> {
+    fn table_of(
+        &mut self,
+        e: &syn::Expr,
+        shape: &[usize],
+        name: &str,
+        meaning: &str,
+    ) -> Option<Vec<ExprId>> {
+        let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
+        let what = format!("`{name}` is a {} array ({meaning})", dims.join(" × "));
         let mut out = Vec::new();
-        self.table(e, shape, &mut out)?;
+        self.table(e, shape, &what, &mut out)?;
         Some(out)
     }
 
@@ -207,7 +237,13 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn integral(&mut self, e: ExprId, span: Option<(f64, f64)>, at: Span, what: &str) -> Option<ExprId> {
+    fn integral(
+        &mut self,
+        e: ExprId,
+        span: Option<(f64, f64)>,
+        at: Span,
+        what: &str,
+    ) -> Option<ExprId> {
         let Some((a, b)) = span else {
             self.cx.error_at(
                 at,
@@ -234,7 +270,8 @@ impl Builder<'_, '_> {
             return None;
         };
         let (Some(a), Some(b)) = (&r.start, &r.end) else {
-            self.cx.error_spanned_by(e, "the range needs both ends: `x0..x1`");
+            self.cx
+                .error_spanned_by(e, "the range needs both ends: `x0..x1`");
             return None;
         };
         let mut ends = [0.0; 2];
@@ -247,7 +284,7 @@ impl Builder<'_, '_> {
             };
             ends[k] = v;
         }
-        if !(ends[0] < ends[1]) {
+        if ends[0] >= ends[1] || ends.iter().any(|x| !x.is_finite()) {
             self.cx
                 .error_spanned_by(e, "the material range `x0..x1` needs x0 < x1");
             return None;
@@ -370,7 +407,7 @@ impl Builder<'_, '_> {
                     })
                     .collect()
             } else {
-                self.table_of(de, &[nf, nf])?
+                self.table_of(de, &[nf, nf], "damping", "elastic × elastic coordinates")?
             };
             let qd: Vec<ExprId> = qf.iter().map(|&i| self.tr.g.var(Var::Qd(i))).collect();
             let dq = mat_vec_rect(self.tr.g, &dmat, nf, &qd);
@@ -382,13 +419,18 @@ impl Builder<'_, '_> {
             self.add_applied(q);
         }
 
-        // Gravity acts at the deformed centre of mass, `R + A ū_c / m`.
+        // Gravity's potential is `−g·∫ρ r = −g·(m R + A ū_c)`: pushed as a unit mass at
+        // the first moment.
         let uc = centre(self.tr.g, &inv, &qv, dim, nf);
+        let auc = mat_vec(self.tr.g, dim, &fv.rotation, &uc);
+        let first: Vec<ExprId> = (0..dim)
+            .map(|i| {
+                let mr = self.tr.g.mul(vec![inv.m, fv.origin[i]]);
+                self.tr.g.add(vec![mr, auc[i]])
+            })
+            .collect();
         let one = self.tr.g.constant(1.0);
-        let minv = self.tr.g.div(one, inv.m);
-        let c: Vec<ExprId> = uc.iter().map(|&x| self.tr.g.mul(vec![minv, x])).collect();
-        let rc = fv.point(self.tr.g, &c);
-        self.masses.push((inv.m, rc));
+        self.masses.push((one, first));
         self.out.bodies.push(BodyOut {
             name: d.name.to_string(),
             docs: d.docs.clone(),
@@ -425,16 +467,26 @@ impl Builder<'_, '_> {
         Some(n)
     }
 
-    fn invariants(&mut self, fl: &Fields<'_>, sh: &Shapes, dim: usize, nf: usize) -> Option<Invariants> {
+    fn invariants(
+        &mut self,
+        fl: &Fields<'_>,
+        sh: &Shapes,
+        dim: usize,
+        nf: usize,
+    ) -> Option<Invariants> {
         let span = fl.span;
+        // Where an integral that fails points: the closure that brought the bad term.
+        let field_span = |name: &str| fl.get(name).map_or(span, Spanned::span);
+        let (rho_at, pos_at, disp_at) = (
+            field_span("density"),
+            field_span("position"),
+            field_span("displacement"),
+        );
         // The rigid part: given like a rigid body's, or integrated.
         let (m, i1, i_kl) = if let Some(me) = fl.get("mass") {
             let m = self.invariant_scalar(me)?;
             let c = match fl.get("com") {
-                Some(e) => {
-                    let v = self.vector(e, dim, Context::Kinematics)?;
-                    v
-                }
+                Some(e) => self.vector(e, dim, Context::Kinematics)?,
                 None => vec![self.tr.g.constant(0.0); dim],
             };
             let i1: Vec<ExprId> = c.iter().map(|&x| self.tr.g.mul(vec![m, x])).collect();
@@ -453,7 +505,9 @@ impl Builder<'_, '_> {
                 let ic = match fl.get("inertia") {
                     Some(e) => match self.tr.field_value(e, Context::Kinematics)? {
                         Value::Matrix(3, v) => v,
-                        Value::Vector(v) if v.len() == 3 => vec![v[0], z, z, z, v[1], z, z, z, v[2]],
+                        Value::Vector(v) if v.len() == 3 => {
+                            vec![v[0], z, z, z, v[1], z, z, z, v[2]]
+                        }
                         other => {
                             self.cx.error_spanned_by(e, format!("the inertia of a spatial body is a 3×3 matrix (or its diagonal); this is {}", other.describe()));
                             return None;
@@ -466,7 +520,11 @@ impl Builder<'_, '_> {
                 for a in 0..3 {
                     for b in 0..3 {
                         let ccab = self.tr.g.mul(vec![c[a], c[b]]);
-                        let s = if a == b { self.tr.g.sub(cc, ccab) } else { self.tr.g.neg(ccab) };
+                        let s = if a == b {
+                            self.tr.g.sub(cc, ccab)
+                        } else {
+                            self.tr.g.neg(ccab)
+                        };
                         let ms = self.tr.g.mul(vec![m, s]);
                         jo.push(self.tr.g.add(vec![ic[3 * a + b], ms]));
                     }
@@ -493,17 +551,17 @@ impl Builder<'_, '_> {
                 );
                 return None;
             };
-            let m = self.integral(rho, sh.span, span, "the mass")?;
+            let m = self.integral(rho, sh.span, rho_at, "the mass")?;
             let mut i1 = Vec::new();
             for &x in &pos {
                 let e = self.tr.g.mul(vec![rho, x]);
-                i1.push(self.integral(e, sh.span, span, "the first moment")?);
+                i1.push(self.integral(e, sh.span, pos_at, "the first moment")?);
             }
             let mut i_kl = Vec::new();
             for a in 0..dim {
                 for b in 0..dim {
                     let e = self.tr.g.mul(vec![rho, pos[a], pos[b]]);
-                    i_kl.push(self.integral(e, sh.span, span, "the second moment")?);
+                    i_kl.push(self.integral(e, sh.span, pos_at, "the second moment")?);
                 }
             }
             (m, i1, i_kl)
@@ -513,7 +571,8 @@ impl Builder<'_, '_> {
             None => None,
         };
         let get = |name: &str| given.as_ref().and_then(|g| g.get(name));
-        let need_shapes = get("s_bar").is_none() || get("i_bar").is_none() || get("s_bar_kl").is_none();
+        let need_shapes =
+            get("s_bar").is_none() || get("i_bar").is_none() || get("s_bar_kl").is_none();
         let (rho, n) = if need_shapes {
             let (Some(rho), Some(n)) = (sh.density, sh.n.clone()) else {
                 self.cx.error_at(
@@ -527,23 +586,29 @@ impl Builder<'_, '_> {
             (None, None)
         };
         let s_bar = match get("s_bar") {
-            Some(e) => self.table_of(e, &[dim, nf])?,
+            Some(e) => self.table_of(e, &[dim, nf], "s_bar", "dimension × elastic coordinates")?,
             None => {
                 let (rho, n) = (rho?, n.clone()?);
                 let mut out = Vec::new();
                 for &x in &n {
                     let e = self.tr.g.mul(vec![rho, x]);
-                    out.push(self.integral(e, sh.span, span, "S̄")?);
+                    out.push(self.integral(e, sh.span, disp_at, "S̄")?);
                 }
                 out
             }
         };
         let i_bar = match get("i_bar") {
-            Some(e) => self.table_of(e, &[dim, dim, nf])?,
+            Some(e) => self.table_of(
+                e,
+                &[dim, dim, nf],
+                "i_bar",
+                "dimension × dimension × elastic coordinates",
+            )?,
             None => {
                 let (rho, n) = (rho?, n.clone()?);
                 let Some(pos) = sh.position.clone() else {
-                    self.cx.error_at(span, "integrating Ī_kl needs `position: |xi| [..]`");
+                    self.cx
+                        .error_at(span, "integrating Ī_kl needs `position: |xi| [..]`");
                     return None;
                 };
                 let mut out = Vec::new();
@@ -551,7 +616,7 @@ impl Builder<'_, '_> {
                     for b in 0..dim {
                         for j in 0..nf {
                             let e = self.tr.g.mul(vec![rho, pos[a], n[b * nf + j]]);
-                            out.push(self.integral(e, sh.span, span, "Ī_kl")?);
+                            out.push(self.integral(e, sh.span, disp_at, "Ī_kl")?);
                         }
                     }
                 }
@@ -559,7 +624,12 @@ impl Builder<'_, '_> {
             }
         };
         let s_kl = match get("s_bar_kl") {
-            Some(e) => self.table_of(e, &[dim, dim, nf, nf])?,
+            Some(e) => self.table_of(
+                e,
+                &[dim, dim, nf, nf],
+                "s_bar_kl",
+                "dimension × dimension × elastic × elastic coordinates",
+            )?,
             None => {
                 let (rho, n) = (rho?, n?);
                 let mut out = Vec::new();
@@ -568,7 +638,7 @@ impl Builder<'_, '_> {
                         for i in 0..nf {
                             for j in 0..nf {
                                 let e = self.tr.g.mul(vec![rho, n[a * nf + i], n[b * nf + j]]);
-                                out.push(self.integral(e, sh.span, span, "S̄_kl")?);
+                                out.push(self.integral(e, sh.span, disp_at, "S̄_kl")?);
                             }
                         }
                     }
@@ -586,7 +656,12 @@ impl Builder<'_, '_> {
         })
     }
 
-    fn deformable_kinetic(&mut self, fv: &crate::model::value::FrameValue, inv: &Invariants, qf: &[u32]) -> ExprId {
+    fn deformable_kinetic(
+        &mut self,
+        fv: &crate::model::value::FrameValue,
+        inv: &Invariants,
+        qf: &[u32],
+    ) -> ExprId {
         let nq = self.tr.nq();
         let g = &mut *self.tr.g;
         let dim = fv.dim;
@@ -614,7 +689,11 @@ impl Builder<'_, '_> {
                 p.push(g.add(vec![pl, pq]));
             }
         }
-        let rd: Vec<ExprId> = fv.origin.iter().map(|&x| time_derivative(g, nq, x)).collect();
+        let rd: Vec<ExprId> = fv
+            .origin
+            .iter()
+            .map(|&x| time_derivative(g, nq, x))
+            .collect();
         let sqd = mat_vec_rect(g, &inv.s_bar, nf, &qd);
         let mut terms = Vec::new();
         let rr = dot(g, &rd, &rd);
@@ -651,11 +730,7 @@ impl Builder<'_, '_> {
             let a = g.mul(vec![tr, ww]);
             let diffe = g.sub(a, wuw);
             terms.push(g.mul(vec![half, diffe]));
-            let h = [
-                g.sub(p[5], p[7]),
-                g.sub(p[6], p[2]),
-                g.sub(p[1], p[3]),
-            ];
+            let h = [g.sub(p[5], p[7]), g.sub(p[6], p[2]), g.sub(p[1], p[3])];
             terms.push(dot(g, &w, &h));
         }
         g.add(terms)
@@ -672,24 +747,37 @@ impl Builder<'_, '_> {
         if let Some(e) = fl.get("stiffness") {
             for other in ["axial_rigidity", "bending_rigidity", "stiffening"] {
                 if let Some(x) = fl.get(other) {
-                    self.cx.error_spanned_by(x, format!("`{other}` derives the stiffness, which `stiffness` already gives"));
+                    self.cx.error_spanned_by(
+                        x,
+                        format!("`{other}` derives the stiffness, which `stiffness` already gives"),
+                    );
                     return None;
                 }
             }
-            return Some(Some(self.table_of(e, &[nf, nf])?));
+            return Some(Some(self.table_of(
+                e,
+                &[nf, nf],
+                "stiffness",
+                "elastic × elastic coordinates",
+            )?));
         }
         let ea = fl.get("axial_rigidity");
         let ei = fl.get("bending_rigidity");
         if ea.is_none() && ei.is_none() {
             if let Some(x) = fl.get("stiffening") {
-                self.cx.error_spanned_by(x, "geometric stiffening needs `axial_rigidity`");
+                self.cx
+                    .error_spanned_by(x, "geometric stiffening needs `axial_rigidity`");
                 return None;
             }
             return Some(None);
         }
-        let at = fl.span;
+        let at = fl.get("displacement").map_or(fl.span, Spanned::span);
+        let pos_at = fl.get("position").map_or(fl.span, Spanned::span);
         let (Some(n), Some(pos)) = (sh.n.clone(), sh.position.clone()) else {
-            self.cx.error_at(at, "a beam's stiffness is derived from `displacement` and `position`");
+            self.cx.error_at(
+                at,
+                "a beam's stiffness is derived from `displacement` and `position`",
+            );
             return None;
         };
         let z = self.tr.g.constant(0.0);
@@ -703,12 +791,12 @@ impl Builder<'_, '_> {
         };
         let xp = diff::differentiate(self.tr.g, pos[0], XI);
         if self.tr.g.depends_on(xp, XI) || self.tr.g.is_zero(xp) {
-            self.cx.error_at(at, "a beam lies along its frame's x axis: `position: |xi| [l * xi, 0.0]` (x linear in the material coordinate)");
+            self.cx.error_at(pos_at, "a beam lies along its frame's x axis: `position: |xi| [l * xi, 0.0]` (x linear in the material coordinate)");
             return None;
         }
         for c in 1..dim {
             if self.tr.g.depends_on(pos[c], XI) {
-                self.cx.error_at(at, "a beam lies along its frame's x axis: its position's other components are constant");
+                self.cx.error_at(pos_at, "a beam lies along its frame's x axis: its position's other components are constant");
                 return None;
             }
         }
@@ -782,7 +870,11 @@ impl Builder<'_, '_> {
                     }
                     let pair = if (j, kk) == (l, mm) { 1.0 } else { 2.0 };
                     let c = self.tr.g.constant(m1 * m2 * pair);
-                    terms.push(self.tr.g.mul(vec![quarter, c, x3, v, qv[j], qv[kk], qv[l], qv[mm]]));
+                    terms.push(
+                        self.tr
+                            .g
+                            .mul(vec![quarter, c, x3, v, qv[j], qv[kk], qv[l], qv[mm]]),
+                    );
                 }
             }
             let sum = self.tr.g.add(terms);
@@ -804,7 +896,9 @@ fn centre(g: &mut Graph, inv: &Invariants, qv: &[ExprId], dim: usize, nf: usize)
 fn mff(g: &mut Graph, inv: &Invariants, dim: usize, nf: usize) -> Vec<ExprId> {
     (0..nf * nf)
         .map(|e| {
-            let parts: Vec<ExprId> = (0..dim).map(|k| inv.s_kl[(k * dim + k) * nf * nf + e]).collect();
+            let parts: Vec<ExprId> = (0..dim)
+                .map(|k| inv.s_kl[(k * dim + k) * nf * nf + e])
+                .collect();
             g.add(parts)
         })
         .collect()

@@ -76,7 +76,12 @@ pub struct Material {
 
 impl Material {
     /// `ū_o(ξ) + N(ξ) q_f` at `xi`, in the body's frame (the current translation context).
-    pub fn at(&self, tr: &mut Translator<'_>, at: &dyn ToTokens, xi: ExprId) -> Option<Vec<ExprId>> {
+    pub fn at(
+        &self,
+        tr: &mut Translator<'_>,
+        at: &dyn ToTokens,
+        xi: ExprId,
+    ) -> Option<Vec<ExprId>> {
         let Some(p) = &self.position else {
             tr.cx.error_spanned_by(
                 at,
