@@ -92,6 +92,12 @@ impl Scene {
                 steady: None,
                 closed_form: None,
             },
+            "flexible_crank" | "flexible_crank_shapes" => Self {
+                t_end: 0.1,
+                span: "the test set's span",
+                steady: None,
+                closed_form: None,
+            },
             "andrews" => Self {
                 t_end: 0.03,
                 span: "the reference span of Hairer & Wanner",
