@@ -18,6 +18,7 @@ pub const BODY: &str = "Body";
 pub const JOINT: &str = "Joint";
 pub const FORCE_ELEMENT: &str = "Force";
 pub const DRAWING: &str = "Drawing";
+pub const CONTACT_ITEM: &str = "Contact";
 pub const Q0: &str = "q0";
 pub const QD0: &str = "qd0";
 pub const DOT: &str = "dot";

@@ -44,7 +44,7 @@ pub enum Item {
     },
     /// A function item with its role.
     Fn(FnItem),
-    /// `static name: Frame|Point|Body|Joint|Force|Drawing = <constructor>;`, a declaration of
+    /// `static name: Frame|Point|Body|Joint|Force|Drawing|Contact = <constructor>;`, a declaration of
     /// the body level.
     Decl(Decl),
 }
@@ -59,6 +59,9 @@ pub enum DeclKind {
     Force,
     /// A shape to draw (`pfaff::Drawing`).
     Drawing,
+    /// A contact between a point and a surface (`PointPlane`, `PointSphere`), compiled to
+    /// a gap function like `#[contact(e)] fn`.
+    Contact,
 }
 
 /// A body-level declaration: its kind, name and constructor expression.
@@ -198,6 +201,7 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 (kw::JOINT, DeclKind::Joint),
                 (kw::FORCE_ELEMENT, DeclKind::Force),
                 (kw::DRAWING, DeclKind::Drawing),
+                (kw::CONTACT_ITEM, DeclKind::Contact),
             ]
             .into_iter()
             .find(|(n, _)| is_type(&s.ty, n))
@@ -214,7 +218,7 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 cx.error_spanned_by(
                     &s.ty,
                     "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
-                     a `Point`, a `Body`, a `Joint`, a `Force` or a `Drawing`",
+                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing` or a `Contact`",
                 );
                 return None;
             }
