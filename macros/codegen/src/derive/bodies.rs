@@ -27,7 +27,7 @@ use crate::model::value::{
     add_v, cross, dot, mat_mat, mat_vec, scale_v, sub_v, time_derivative, FrameValue, Value,
 };
 use crate::parse::{Decl, DeclKind};
-use crate::sym::{diff, transform, ExprId, Func, Graph, Var};
+use crate::sym::{diff, transform, Deps, ExprId, Func, Graph, Var};
 
 /// A frame as exported in `Info`.
 #[derive(Debug)]
@@ -255,6 +255,8 @@ struct Builder<'t, 'a> {
     gravity: Option<(Vec<ExprId>, Span)>,
     attachments: Vec<Attachment>,
     shapes: Vec<UserShape>,
+    /// The up direction of a `Scene` item.
+    up: Option<Vec<ExprId>>,
 }
 
 /// Expands the body-level declarations of the model translated by `tr`.
@@ -291,6 +293,7 @@ pub fn expand<'a>(
         gravity: None,
         attachments: Vec::new(),
         shapes: Vec::new(),
+        up: None,
     };
     let mut ok = true;
     for d in decls {
@@ -373,7 +376,15 @@ pub fn expand<'a>(
         .iter()
         .map(|p| (p.name.clone(), p.frame, p.position.clone()))
         .collect();
-    b.out.drawing = super::drawing::build(g, &origins, &bodies, &points, &b.attachments, &b.shapes);
+    b.out.drawing = super::drawing::build(
+        g,
+        &origins,
+        &bodies,
+        &points,
+        &b.attachments,
+        &b.shapes,
+        b.up.as_deref(),
+    );
     b.out.kinetic = g.add(std::mem::take(&mut b.kinetic));
     b.out.potential = g.add(std::mem::take(&mut b.potential));
     Some(b.out)
@@ -620,9 +631,11 @@ impl<'a> Builder<'_, 'a> {
         let vv = dot(self.g(), &vc, &vc);
         let half = self.g().constant(0.5);
         let mut terms = vec![self.g().mul(vec![half, mass, vv])];
+        let mut principal = Vec::new();
         if let Some(ie) = fl.get("inertia") {
             if dim == 2 {
                 let i = self.scalar(ie, Context::Kinematics)?;
+                principal.push(i);
                 let Value::Scalar(w) = fv.angular_velocity(self.g(), nq) else {
                     unreachable!("planar frames have a scalar rate")
                 };
@@ -651,6 +664,7 @@ impl<'a> Builder<'_, 'a> {
                         }
                     }
                 }
+                principal.extend([inertia[0], inertia[4], inertia[8]]);
                 let w = fv.body_angular_velocity(self.g(), nq);
                 let iw = mat_vec(self.g(), 3, &inertia, &w);
                 let wiw = dot(self.g(), &w, &iw);
@@ -660,6 +674,11 @@ impl<'a> Builder<'_, 'a> {
         let t = self.g().add(terms);
         self.kinetic.push(t);
         self.masses.push((mass, rc));
+        self.attachments.push(Attachment::Mass {
+            frame: idx(k),
+            mass,
+            inertia: principal,
+        });
         self.out.bodies.push(BodyOut {
             name: d.name.to_string(),
             docs: d.docs.clone(),
@@ -1104,6 +1123,9 @@ impl<'a> Builder<'_, 'a> {
     /// shapes of [`DRAWING_KINDS`].
     fn drawing(&mut self, d: &Decl) -> Option<()> {
         let fl = fields(self.cx, &d.expr, DRAWING_KINDS, "shape")?;
+        if fl.kind == super::drawing::SCENE {
+            return self.scene(d, &fl);
+        }
         let kind = super::drawing::shape_kind(&fl.kind)?;
         let frame = match fl.get("frame") {
             Some(e) => self.frame_of(e)?,
@@ -1168,6 +1190,47 @@ impl<'a> Builder<'_, 'a> {
             radius,
             color,
         });
+        Some(())
+    }
+
+    /// `static name: Drawing = Scene { up: [..] }`: the direction that is up, a constant
+    /// vector (numbers and parameters) of the model's dimension, declared once.
+    fn scene(&mut self, d: &Decl, fl: &Fields<'_>) -> Option<()> {
+        let e = fl.get("up")?;
+        if self.up.is_some() {
+            self.cx.error_spanned_by(
+                &d.name,
+                "the scene is declared twice: one `Scene` item says which way is up",
+            );
+            return None;
+        }
+        // Without frames, the drawing's own points say whether the model is drawn in
+        // 2-D or 3-D; either vector is accepted.
+        let v = if self.tr.frames.is_empty() {
+            let mut dim = None;
+            self.draw_vector(e, None, &mut dim, true)?
+        } else {
+            let dim = self.tr.model_dim();
+            self.vector(e, dim, Context::Kinematics)?
+        };
+        let moving = v.iter().any(|&x| {
+            let deps = self.tr.g.deps(x);
+            deps.has(Deps::Q) || deps.has(Deps::TIME)
+        });
+        if moving {
+            self.cx.error_spanned_by(
+                e,
+                "the `up` direction of a scene is constant: numbers and parameters, not \
+                 coordinates or time",
+            );
+            return None;
+        }
+        if v.iter().all(|&x| self.tr.g.is_zero(x)) {
+            self.cx
+                .error_spanned_by(e, "the `up` direction of a scene is the zero vector");
+            return None;
+        }
+        self.up = Some(v);
         Some(())
     }
 

@@ -780,7 +780,7 @@ fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream)
 /// The trait methods `drawing` (the static shapes) and `drawing_values` (the points'
 /// global coordinates, then the scalars), when the model has shapes.
 fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut) -> TokenStream {
-    if d.shapes.is_empty() {
+    if d.shapes.is_empty() && d.up.is_none() {
         return TokenStream::new();
     }
     let opt = |x: Option<u32>| match x {
@@ -806,6 +806,7 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
         })
     });
     let scalars = u32::try_from(d.scalars.len()).expect("drawing size fits u32");
+    let up = opt(d.up);
     let mut roots: Vec<ExprId> = d
         .points
         .iter()
@@ -819,6 +820,7 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
                 points: &[#(#points),*],
                 scalars: #scalars,
                 shapes: &[#(#shapes),*],
+                up: #up,
             };
             &DRAWING
         }
