@@ -19,6 +19,7 @@
 pub mod bodies;
 mod checks;
 pub mod contacts;
+pub mod data;
 pub mod drawing;
 pub mod free_motion;
 pub mod linear;
@@ -94,6 +95,8 @@ pub struct Derived {
     pub linear: Option<linear::Linear>,
     /// Contacts (`#[contact(e)]` gap functions) and their normal Jacobian.
     pub contacts: contacts::Contacts,
+    /// Per data slot, a beam's parameter expressions (`None`: set by the program).
+    pub data: Vec<Option<data::BeamExprs>>,
 }
 
 fn idx(i: usize) -> u32 {
@@ -110,6 +113,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     tr.definitions();
 
     let param_defaults = checks::param_defaults(cx, model, &mut tr);
+    let data = data::translate(cx, model, &mut tr, &param_defaults);
 
     let initial = if model
         .coords
@@ -472,6 +476,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let contacts = contacts::derive(cx, model, g, contact_rows, &param_defaults, checking)?;
     let mut derived = Derived {
         contacts,
+        data,
         holonomic_names,
         nonholonomic_names,
         bodies: body_level,

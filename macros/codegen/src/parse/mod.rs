@@ -44,6 +44,13 @@ pub enum Item {
     },
     /// A function item with its role.
     Fn(FnItem),
+    /// `static name: Data = Data { len: N } | Beam { .. };`, an array of run-time data
+    /// (`model::data`).
+    Data {
+        name: syn::Ident,
+        docs: String,
+        expr: syn::Expr,
+    },
     /// `static name: Frame|Point|Body|Joint|Force|Drawing|Contact = <constructor>;`, a declaration of
     /// the body level.
     Decl(Decl),
@@ -206,6 +213,13 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
             .into_iter()
             .find(|(n, _)| is_type(&s.ty, n))
             .map(|(_, k)| k);
+            if is_type(&s.ty, kw::DATA) {
+                return Some(Item::Data {
+                    name: s.ident,
+                    docs,
+                    expr: *s.expr,
+                });
+            }
             if let Some(kind) = kind {
                 return Some(Item::Decl(Decl {
                     kind,
@@ -218,7 +232,8 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 cx.error_spanned_by(
                     &s.ty,
                     "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
-                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing` or a `Contact`",
+                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing`, a `Contact` or \
+                     run-time `Data`",
                 );
                 return None;
             }
