@@ -75,3 +75,112 @@ pub fn translate(
     }
     out
 }
+
+/// The invariants held by a data slot, as `Var::Data` leaves in the flat layout of
+/// `pfaff::flex::Invariants::write_flat` (each field row-major as documented there).
+#[derive(Debug)]
+pub struct SlotLeaves {
+    pub m: ExprId,
+    /// `Ī₁` (d).
+    pub i1: Vec<ExprId>,
+    /// `S̄` (d × n).
+    pub s_bar: Vec<ExprId>,
+    /// `I_kl` (d × d).
+    pub i_kl: Vec<ExprId>,
+    /// `Ī_kl` (d × d × n).
+    pub i_bar: Vec<ExprId>,
+    /// `S̄_kl` (d × d × n × n).
+    pub s_kl: Vec<ExprId>,
+    /// `M_ff` (n × n).
+    pub m_ff: Vec<ExprId>,
+    /// `K_ff` (n × n).
+    pub k_ff: Vec<ExprId>,
+}
+
+/// The invariants of a deformable body of `d` axes and `n` elastic coordinates read from
+/// the data slot named by `e` (`data: rod` in its declaration).
+///
+/// Errors (recorded in `cx`, spanned at `e`): `e` is not the name of a data slot; a
+/// beam slot's axes or coordinates differ from the body's; a slot set by the program
+/// has another length than the layout's.
+pub fn slot_leaves(
+    cx: &Ctxt,
+    model: &Model,
+    g: &mut crate::sym::Graph,
+    e: &syn::Expr,
+    d: usize,
+    n: usize,
+) -> Option<SlotLeaves> {
+    let slot = match e {
+        syn::Expr::Path(p) => p
+            .path
+            .get_ident()
+            .and_then(|id| model.data_slot(&id.to_string())),
+        _ => None,
+    };
+    let Some(slot) = slot else {
+        let names: Vec<String> = model.data.iter().map(|s| format!("`{}`", s.name)).collect();
+        cx.error_spanned_by(
+            e,
+            if names.is_empty() {
+                "expected the name of a data slot (`static rod: Data = Beam { .. };`); the model declares none".to_owned()
+            } else {
+                format!("expected the name of a data slot: {}", names.join(", "))
+            },
+        );
+        return None;
+    };
+    let len = crate::model::data::flat_len(d, n);
+    if let Some(b) = &slot.beam {
+        if (b.d, b.n) != (d, n) {
+            cx.error_spanned_by(
+                e,
+                format!(
+                    "beam `{}` is {} with {} elastic coordinates; this body is {} with {n}",
+                    slot.name,
+                    if b.d == 2 { "planar" } else { "spatial" },
+                    b.n,
+                    if d == 2 { "planar" } else { "spatial" },
+                ),
+            );
+            return None;
+        }
+    } else if slot.len != len {
+        cx.error_spanned_by(
+            e,
+            format!(
+                "data slot `{}` holds {} values; the invariants of a {} body with {n} elastic coordinates take {len}",
+                slot.name,
+                slot.len,
+                if d == 2 { "planar" } else { "spatial" },
+            ),
+        );
+        return None;
+    }
+    let mut at = slot.offset;
+    let mut take = |g: &mut crate::sym::Graph, k: usize| -> Vec<ExprId> {
+        let out = (at..at + k)
+            .map(|i| g.var(Var::Data(u32::try_from(i).expect("data size fits u32"))))
+            .collect();
+        at += k;
+        out
+    };
+    let m = take(g, 1)[0];
+    let i1 = take(g, d);
+    let s_bar = take(g, d * n);
+    let i_kl = take(g, d * d);
+    let i_bar = take(g, d * d * n);
+    let s_kl = take(g, d * d * n * n);
+    let m_ff = take(g, n * n);
+    let k_ff = take(g, n * n);
+    Some(SlotLeaves {
+        m,
+        i1,
+        s_bar,
+        i_kl,
+        i_bar,
+        s_kl,
+        m_ff,
+        k_ff,
+    })
+}
