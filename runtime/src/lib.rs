@@ -98,8 +98,9 @@ pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Works
 #[doc(hidden)]
 pub mod __private {
     pub use crate::drawing::{DrawPoint, Drawing, Shape, ShapeKind};
+    pub use crate::flex;
     pub use crate::mechanism::{
-        Body, Contact, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
-        Parameter, Point, Symbol, TimeDependence,
+        Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind,
+        Mechanism, Parameter, Point, Symbol, TimeDependence,
     };
 }
