@@ -17,7 +17,8 @@
 /// Two `RollingWheel` joints generate the two holonomic contact conditions (which fix
 /// `z` and `theta`) and the four no-slip conditions. Linearized about upright straight
 /// running at speed `v` (`pfaff linearize bicycle --speed V`), the lean and steer obey
-/// the benchmark's `M q̈ + v C1 q̇ + (g K0 + v² K2) q = 0`.
+/// the benchmark's `M q̈ + v C1 q̇ + (g K0 + v² K2) q = 0`. It is drawn with z down
+/// (`Scene { up }`), the frame and fork as tubes through their joints.
 #[pfaff::mechanism(linearize)]
 pub mod bicycle {
     /// Wheel base [m].
@@ -150,6 +151,55 @@ pub mod bicycle {
         axis: [0.0, 1.0, 0.0],
         radius: r_f,
         up: [0.0, 0.0, -1.0],
+    };
+
+    /// The benchmark's axes have z down.
+    static view: Drawing = Scene {
+        up: [0.0, 0.0, -1.0],
+    };
+    /// The rear frame as drawn (rear-frame coordinates, origin at the rear hub, z
+    /// down): the chain and seat stays from the hub to the bottom bracket and the
+    /// saddle, and the tubes to the head tube on the steer axis.
+    static rear_stays: Drawing = Link {
+        frame: rear_frame,
+        points: [
+            [0.0, 0.0, 0.0],
+            [0.4, 0.0, 0.03],
+            [0.3, 0.0, -0.65],
+            [0.0, 0.0, 0.0],
+        ],
+        color: "#2c3e50",
+    };
+    static rear_tubes: Drawing = Link {
+        frame: rear_frame,
+        points: [
+            [0.3, 0.0, -0.65],
+            [w + c - (r_r + 0.55) * lambda.tan(), 0.0, -0.55],
+            [w + c - (r_r + 0.3) * lambda.tan(), 0.0, -0.3],
+            [0.4, 0.0, 0.03],
+        ],
+        color: "#2c3e50",
+    };
+    /// The fork and handlebar as drawn (front-frame coordinates: origin where the
+    /// steer axis meets the ground, z down): from the front hub to the crown on the
+    /// steer axis, up the axis to the stem, and the bar across.
+    static fork: Drawing = Link {
+        frame: front_frame,
+        points: [
+            [-c, 0.0, -r_f],
+            [-0.6 * lambda.tan(), 0.0, -0.6],
+            [-1.0 * lambda.tan(), 0.0, -1.0],
+        ],
+        color: "#c0392b",
+    };
+    static handlebar: Drawing = Link {
+        frame: front_frame,
+        points: [
+            [-1.0 * lambda.tan() - 0.08, -0.28, -1.0],
+            [-1.0 * lambda.tan(), 0.0, -1.0],
+            [-1.0 * lambda.tan() - 0.08, 0.28, -1.0],
+        ],
+        color: "#c0392b",
     };
 
     /// Forward speed of the rear wheel's centre along the rear frame's heading [m/s].

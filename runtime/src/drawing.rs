@@ -6,7 +6,9 @@
 //! `static name: Drawing = ..` items (see the README). The static part is a [`Drawing`];
 //! the positions of its points and the values of its radii are written by
 //! [`Mechanism::drawing_values`](crate::Mechanism::drawing_values), as functions of
-//! `(t, q)` like every other generated quantity.
+//! `(t, q)` like every other generated quantity. A `static name: Drawing = Scene { up }`
+//! item says which way is up (the viewer's camera and ground follow it), for models
+//! whose axes are not the default `+z` up (spatial) or `+y` up (planar).
 
 /// What a shape is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -72,6 +74,10 @@ pub struct Drawing {
     pub scalars: u32,
     /// The shapes, drawn in order.
     pub shapes: &'static [Shape],
+    /// Which way is up, declared by a `Scene { up }` item: the index of the first of
+    /// three scalars holding the direction (global coordinates; `z = 0` in planar
+    /// models). `None`: the default, `+z` in spatial models and `+y` in planar ones.
+    pub up: Option<u32>,
 }
 
 impl Drawing {
@@ -80,6 +86,7 @@ impl Drawing {
         points: &[],
         scalars: 0,
         shapes: &[],
+        up: None,
     };
 
     /// The number of values [`Mechanism::drawing_values`](crate::Mechanism::drawing_values)

@@ -35,4 +35,7 @@ pub enum Error {
     /// The impulse solve of an impact.
     #[error(transparent)]
     Impact(#[from] crate::impact::ImpactError),
+    /// Building or reducing a deformable body.
+    #[error(transparent)]
+    Flex(#[from] crate::flex::FlexError),
 }

@@ -31,6 +31,9 @@
 //! - [`PoseExt`]: frame poses and points as nalgebra types ([`nalgebra`] is re-exported).
 //! - [`replay`]: the JSON trajectory format (times, poses, outputs, the drawing) for
 //!   viewers and other tools.
+//! - [`flex`]: deformable bodies from beam elements: inertia shape integrals and
+//!   stiffness, reference conditions, modal reduction and Craig–Bampton, done once
+//!   before a run.
 //! - [`Error`]: every module's error, joined.
 
 /// nalgebra, in the version whose types [`PoseExt`] returns.
@@ -42,6 +45,7 @@ mod drawing;
 mod dynamics;
 mod error;
 mod ext;
+pub mod flex;
 pub mod free_motion;
 mod impact;
 mod joint_reactions;
@@ -94,8 +98,9 @@ pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Works
 #[doc(hidden)]
 pub mod __private {
     pub use crate::drawing::{DrawPoint, Drawing, Shape, ShapeKind};
+    pub use crate::flex;
     pub use crate::mechanism::{
-        Body, Contact, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
-        Parameter, Point, Symbol, TimeDependence,
+        Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind,
+        Mechanism, Parameter, Point, Symbol, TimeDependence,
     };
 }

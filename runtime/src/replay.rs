@@ -214,6 +214,11 @@ pub struct DrawingTrack {
     pub points: Vec<PointTrack>,
     /// The shapes, drawn in order.
     pub shapes: Vec<ShapeMeta>,
+    /// The unit vector that points up, for a viewer's camera and ground: the model's
+    /// `Scene { up }`, or by default `+z` in 3-D and `+y` in 2-D. Absent in files that
+    /// predate it (readers take the default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<[f64; 3]>,
 }
 
 /// A run in the JSON trajectory format.
@@ -624,6 +629,17 @@ impl Replay {
                 && draw_points
                     .iter()
                     .any(|p| p.position.chunks_exact(3).any(|v| v[2] != 0.0)));
+        let declared = drawing.up.and_then(|k| {
+            let k = k as usize;
+            let v = scalars.get(k..k + 3)?;
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            (n > 0.0 && n.is_finite()).then(|| [v[0] / n, v[1] / n, v[2] / n])
+        });
+        let up = declared.unwrap_or(if spatial {
+            [0.0, 0.0, 1.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        });
         Replay {
             format: FORMAT.to_owned(),
             version: VERSION,
@@ -671,6 +687,7 @@ impl Replay {
             drawing: DrawingTrack {
                 points: draw_points,
                 shapes,
+                up: Some(up),
             },
         }
     }

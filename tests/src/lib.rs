@@ -23,6 +23,8 @@ mod linear;
 #[cfg(test)]
 mod replay;
 #[cfg(test)]
+mod run_data;
+#[cfg(test)]
 mod sim;
 #[cfg(test)]
 mod snapshots;

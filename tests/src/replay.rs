@@ -161,3 +161,32 @@ fn impacts_are_events_and_samples() {
         "the ball touches the floor"
     );
 }
+
+/// Which way is up: the bicycle declares the benchmark's z down (`Scene { up: [0, 0,
+/// −1] }`), the other models take the default of their dimension (+z spatial, +y
+/// planar); the key round-trips, and a file without it reads back as `None` (the
+/// default for readers).
+#[test]
+fn the_up_direction_is_declared_or_the_default() {
+    let bicycle = pfaff_models::bicycle::Model::default();
+    for (model, up) in [
+        (Box::new(bicycle) as Box<dyn Mechanism>, [0.0, 0.0, -1.0]),
+        (Box::new(free_body::Model::default()), [0.0, 0.0, 1.0]),
+        (
+            Box::new(slider_crank_bodies::Model::default()),
+            [0.0, 1.0, 0.0],
+        ),
+    ] {
+        let replay = replay_of(model.as_ref(), 0.1, &ReplayOptions::default());
+        assert_eq!(replay.drawing.up, Some(up), "{}", model.info().name);
+        let back = Replay::from_json(&replay.to_json()).expect("reads back");
+        assert_eq!(back.drawing.up, Some(up));
+        let mut v: serde_json::Value = serde_json::from_str(&replay.to_json()).expect("JSON");
+        v["drawing"]
+            .as_object_mut()
+            .expect("an object")
+            .remove("up");
+        let old = Replay::from_json(&v.to_string()).expect("a file without `up` reads");
+        assert_eq!(old.drawing.up, None);
+    }
+}

@@ -91,6 +91,7 @@ impl Analysis {
             Var::Delta(i) => format!("δ{}", m.coords[i as usize].name),
             Var::Param(i) => m.params[i as usize].name.to_string(),
             Var::Input(i) => format!("u{i}"),
+            Var::Data(i) => crate::model::data::entry_name(&m.data, i),
         };
         let g = &self.graph;
         let d = &self.derived;

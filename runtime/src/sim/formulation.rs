@@ -70,6 +70,17 @@ pub(crate) trait Form {
         t: f64,
     ) -> Result<(), SimErrorKind>;
 
+    /// Fills `p` from `y` at `t` for a state the driver keeps (accepted or output),
+    /// before [`keep`](Self::keep) corrects it.
+    fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        self.reconstruct(p, t, y)
+    }
+
     /// Corrects a state the driver keeps (accepted or output), already reconstructed.
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
@@ -94,17 +105,18 @@ fn copy_state<M: Mechanism + ?Sized>(p: &mut Point<'_, M>, y: &[f64]) {
 /// The chart's Newton converges to the intersection of the normal space through the
 /// prediction with the manifold nearest to it; a correction larger than the move from
 /// the last accepted state means it went to another one (the mirror assembly of a
-/// loop), so the evaluation fails, recoverably. The move counts the time elapsed at the
-/// accepted speed: a rheonomic constraint moves the manifold under a prediction that
-/// has not moved yet (an implicit method's first stage iterate is the accepted state).
+/// loop), so the evaluation fails, recoverably.
 #[derive(Debug)]
 pub(crate) struct Partitioned {
     chart: Chart,
-    /// The last accepted positions.
+    /// The last accepted positions, their time and the largest accepted speed
+    /// $\|\dot q\|_\infty$: in a rheonomic model the manifold moves with time, so an
+    /// evaluation at the accepted positions but a later time needs a correction of
+    /// about $|t - t_a|\,\|\dot q_a\|_\infty$ (Radau5's first stage guesses are the
+    /// accepted state itself), which is no branch switch.
     accepted: Vec<f64>,
-    /// The time and the largest velocity of the last accepted state.
-    accepted_t: f64,
-    accepted_speed: f64,
+    t_accepted: f64,
+    speed_accepted: f64,
     /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
     /// before the first anchor): the reference of [`REFIT_FRACTION`].
     fit_ratio: f64,
@@ -120,8 +132,8 @@ impl Partitioned {
         Self {
             chart: Chart::new(n, m, mh, rtol, atol),
             accepted: vec![0.0; n],
-            accepted_t: 0.0,
-            accepted_speed: 0.0,
+            t_accepted: 0.0,
+            speed_accepted: 0.0,
             fit_ratio: 0.0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
@@ -139,8 +151,8 @@ impl Form for Partitioned {
         t: f64,
     ) -> Result<(), SimErrorKind> {
         self.accepted.copy_from_slice(&p.q);
-        self.accepted_t = t;
-        self.accepted_speed = inf_norm(&p.qd);
+        self.t_accepted = t;
+        self.speed_accepted = inf_norm(&p.qd);
         if p.rows_h == 0 {
             return Ok(());
         }
@@ -203,10 +215,10 @@ impl Form for Partitioned {
                 moved = moved.max((yj - aj).abs());
                 correction = correction.max((qj - yj).abs());
             }
-            moved += (t - self.accepted_t).abs() * self.accepted_speed;
             let scale = inf_norm(&p.q);
             let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
-            if correction > moved + floor {
+            let drift = 2.0 * (t - self.t_accepted).abs() * self.speed_accepted;
+            if correction > moved + drift + floor {
                 return Err(SimErrorKind::NewtonFailed {
                     t,
                     iterations: 0,
@@ -232,6 +244,27 @@ impl Form for Partitioned {
     /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
     /// Newton, then the velocities): below the integrator's tolerance, so the
     /// derivatives the integrator keeps stay valid.
+    /// A kept state the chart's chord iteration cannot correct (an output point far
+    /// inside a long step of Radau5's dense output, where the anchor's normals no
+    /// longer contract) is left to [`keep`](Form::keep)'s full Newton projection from
+    /// `y` itself: an evaluation would be retried with a shorter step, a kept point
+    /// cannot.
+    fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        match self.reconstruct(p, t, y) {
+            Err(SimErrorKind::NewtonFailed { .. }) => {
+                self.cached = None;
+                copy_state(p, y);
+                Ok(())
+            }
+            r => r,
+        }
+    }
+
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -469,6 +502,15 @@ impl AnyForm {
         y: &[f64],
     ) -> Result<(), SimErrorKind> {
         each!(self, f => f.reconstruct(p, t, y))
+    }
+
+    pub fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.reconstruct_kept(p, t, y))
     }
 
     pub fn accelerations<M: Mechanism + ?Sized>(

@@ -129,3 +129,37 @@ fn default_shapes_of_the_spatial_zoo() {
     assert_eq!((hinge.kind, hinge.frame), (ShapeKind::Marker, None));
     assert_eq!(point(&v, hinge.points[0]), Vector3::new(0.1, 0.2, 0.3));
 }
+
+/// A body drawn as a block (no joint or named point to draw it by) is sized by its own
+/// mass and inertia, not by the extent of a run: the half-side of the uniform box with
+/// them, $\sqrt{\operatorname{tr}\bar I/2m}$ (a cube of half-side $h$ has
+/// $\bar I = \tfrac23 m h^2$ about each axis). `free_body`: $\bar I = \operatorname{diag}(1,
+/// 1, 2)$, $m = 1$, so $h = \sqrt 2$; the block follows a parameter change.
+#[test]
+fn a_block_is_sized_by_its_body() {
+    let mut m = pfaff_models::free_body::Model::default();
+    let d = m.drawing();
+    let block = d
+        .shapes
+        .iter()
+        .find(|s| s.name == "body")
+        .expect("the body's shape");
+    assert_eq!(block.kind, ShapeKind::Marker);
+    let r = 3 * d.points.len() + block.radius.expect("a size") as usize;
+    let q = state(m.info().nq(), 7);
+    assert!((values(&m, 0.0, &q)[r] - 2f64.sqrt()).abs() < 1e-15);
+    let i = m.info().parameter_index("m").expect("a mass parameter");
+    m.set_parameter(i, 4.0);
+    assert!((values(&m, 0.0, &q)[r] - 0.5 * 2f64.sqrt()).abs() < 1e-15);
+    assert_eq!(d.up, None, "free_body declares no up direction");
+}
+
+/// `Scene { up }` is three scalars of the drawing: the bicycle's `[0, 0, −1]`.
+#[test]
+fn the_bicycle_is_drawn_z_down() {
+    let m = pfaff_models::bicycle::Model::default();
+    let d = m.drawing();
+    let k = 3 * d.points.len() + d.up.expect("the bicycle declares up") as usize;
+    let q = state(m.info().nq(), 1);
+    assert_eq!(&values(&m, 0.0, &q)[k..k + 3], &[0.0, 0.0, -1.0]);
+}

@@ -9,14 +9,18 @@
 //!
 //! Defaults: a body is the chain of segments through its joint points, spring ends and
 //! named points (a closed outline from three on), or the segment from its origin to its
-//! one joint point, or a block at its origin; a `Distance` joint is a rod; a spring is a
-//! zigzag; a rolling wheel is a disc on a ground plane; a guide (a prismatic joint to the
-//! ground) is a ground line; a revolute joint to the ground is a support marker. A
-//! `Drawing` item with a `frame` replaces that frame's default shape.
+//! one joint point, or a block at its origin whose half-size is the body's own (the
+//! half-side of the uniform box of its mass and inertia: $\sqrt{3J/2m}$ planar,
+//! $\sqrt{\operatorname{tr} I/2m}$ spatial), so that nothing is sized from the extent of
+//! a run; a `Distance` joint is a rod; a spring is a zigzag; a rolling wheel is a disc
+//! on a ground plane; a guide (a prismatic joint to the ground) is a ground line; a
+//! revolute joint to the ground is a support marker. A `Drawing` item with a `frame`
+//! replaces that frame's default shape. A `Scene { up }` item gives the direction that
+//! is up (three scalars, [`DrawingOut::up`]).
 
 use std::collections::HashMap;
 
-use crate::sym::{ExprId, Graph};
+use crate::sym::{ExprId, Func, Graph};
 
 /// A drawing point: a global 3-vector (a position, or a direction for a normal).
 #[derive(Debug)]
@@ -45,6 +49,9 @@ pub struct DrawingOut {
     pub points: Vec<DrawPointOut>,
     pub scalars: Vec<ExprId>,
     pub shapes: Vec<ShapeOut>,
+    /// The index of the first of three scalars holding the up direction, when the
+    /// model declares one.
+    pub up: Option<u32>,
 }
 
 /// What a joint or a force element adds to the drawing; vectors are global, in the
@@ -65,7 +72,8 @@ pub enum Attachment {
         frame: u32,
         point: Vec<ExprId>,
     },
-    /// A guide fixed in the ground: a line (plane) through `point` normal to `normal`.
+    /// A guide fixed in the ground, or the plane of a `PointPlane` contact fixed in the
+    /// ground: a line (plane) through `point` normal to `normal`.
     Guide {
         name: String,
         point: Vec<ExprId>,
@@ -81,6 +89,13 @@ pub enum Attachment {
         radius: ExprId,
         contact: Vec<ExprId>,
         up: Vec<ExprId>,
+    },
+    /// A body's mass and inertia (planar: `[J]`; spatial: the diagonal of its tensor),
+    /// which size its default block.
+    Mass {
+        frame: u32,
+        mass: ExprId,
+        inertia: Vec<ExprId>,
     },
     /// A spring between two frames.
     Spring {
@@ -110,11 +125,18 @@ pub const DRAWING_KINDS: &[(&str, &[&str], &[&str])] = &[
     ("Spring", &["points"], &["frame", "color"]),
     ("Ground", &["at", "normal"], &["color"]),
     ("Marker", &["points"], &["frame", "radius", "color"]),
+    ("Scene", &["up"], &[]),
 ];
+
+/// The `Drawing` kind that is not a shape: what the scene is (which way is up).
+pub const SCENE: &str = "Scene";
 
 /// The `pfaff::ShapeKind` variant of a `Drawing` kind.
 pub fn shape_kind(kind: &str) -> Option<&'static str> {
-    DRAWING_KINDS.iter().map(|k| k.0).find(|k| *k == kind)
+    DRAWING_KINDS
+        .iter()
+        .map(|k| k.0)
+        .find(|k| *k == kind && *k != SCENE)
 }
 
 struct Collector<'g> {
@@ -163,9 +185,27 @@ impl Collector<'_> {
     }
 }
 
+/// The half-size of the uniform box of `mass` and `inertia` (see the module's doc), or
+/// `None` without an inertia.
+fn block_size(g: &mut Graph, mass: ExprId, inertia: &[ExprId]) -> Option<ExprId> {
+    let factor = match inertia.len() {
+        1 => 1.5,
+        3 => 0.5,
+        _ => return None,
+    };
+    let trace = g.add(inertia.to_vec());
+    if g.is_zero(trace) {
+        return None;
+    }
+    let k = g.constant(factor);
+    let kt = g.mul(vec![k, trace]);
+    let s = g.div(kt, mass);
+    Some(g.call(Func::Sqrt, s))
+}
+
 /// The drawing of a model with `frames` (each with its origin) and `bodies` (their
-/// frames), named points `(name, frame, position)`, the attachments and the user's
-/// shapes.
+/// frames), named points `(name, frame, position)`, the attachments, the user's
+/// shapes and the declared up direction.
 pub fn build(
     g: &mut Graph,
     origins: &[Vec<ExprId>],
@@ -173,12 +213,20 @@ pub fn build(
     points: &[(String, u32, Vec<ExprId>)],
     attachments: &[Attachment],
     user: &[UserShape],
+    up: Option<&[ExprId]>,
 ) -> DrawingOut {
     let mut c = Collector {
         g,
         out: DrawingOut::default(),
         index: HashMap::new(),
     };
+    if let Some(u) = up {
+        let zero = c.g.constant(0.0);
+        let first = c.scalar(u[0]);
+        c.scalar(u[1]);
+        c.scalar(u.get(2).copied().unwrap_or(zero));
+        c.out.up = Some(first);
+    }
     // Grounds first (drawn below everything), one per distinct plane.
     let mut grounds: Vec<(Vec<ExprId>, Vec<ExprId>)> = Vec::new();
     for a in attachments {
@@ -193,7 +241,12 @@ pub fn build(
             } => (name, contact, up),
             _ => continue,
         };
-        if matches!(a, Attachment::Wheel { .. }) && grounds.iter().any(|(_, n)| n == normal) {
+        // One ground per rolling plane, and per distinct guide or contact plane.
+        let wheel = matches!(a, Attachment::Wheel { .. });
+        if grounds
+            .iter()
+            .any(|(p, n)| n == normal && (wheel || p == point))
+        {
             continue;
         }
         grounds.push((point.clone(), normal.clone()));
@@ -264,6 +317,20 @@ pub fn build(
             0 => {
                 let o = c.point(&format!("{name}.origin"), Some(*frame), &origin);
                 c.shape(name, "Marker", Some(*frame), vec![o]);
+                let size = attachments.iter().find_map(|a| match a {
+                    Attachment::Mass {
+                        frame: f,
+                        mass,
+                        inertia,
+                    } if f == frame => block_size(c.g, *mass, inertia),
+                    _ => None,
+                });
+                if let Some(s) = size {
+                    let r = c.scalar(s);
+                    if let Some(shape) = c.out.shapes.last_mut() {
+                        shape.radius = Some(r);
+                    }
+                }
             }
             1 => {
                 let o = c.point(&format!("{name}.origin"), Some(*frame), &origin);

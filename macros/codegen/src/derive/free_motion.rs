@@ -168,6 +168,7 @@ pub fn formulas(g: &Graph, model: &Model, fm: &FreeMotion) -> Vec<String> {
         Var::Delta(i) => format!("Q_{}", model.coords[i as usize].name),
         Var::Param(i) => model.params[i as usize].name.to_string(),
         Var::Input(i) => format!("u{i}"),
+        Var::Data(i) => crate::model::data::entry_name(&model.data, i),
     };
     let (temps, order) = shared(g, &fm.symbolic);
     let p = Printer {

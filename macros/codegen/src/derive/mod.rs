@@ -19,6 +19,7 @@
 pub mod bodies;
 mod checks;
 pub mod contacts;
+pub mod data;
 pub mod drawing;
 pub mod free_motion;
 pub mod integrate;
@@ -95,6 +96,8 @@ pub struct Derived {
     pub linear: Option<linear::Linear>,
     /// Contacts (`#[contact(e)]` gap functions) and their normal Jacobian.
     pub contacts: contacts::Contacts,
+    /// Per data slot, a beam's parameter expressions (`None`: set by the program).
+    pub data: Vec<Option<data::BeamExprs>>,
 }
 
 fn idx(i: usize) -> u32 {
@@ -111,6 +114,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     tr.definitions();
 
     let param_defaults = checks::param_defaults(cx, model, &mut tr);
+    let data = data::translate(cx, model, &mut tr, &param_defaults);
 
     let initial = if model
         .coords
@@ -207,7 +211,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         .iter()
         .map(|f| user_row(&mut tr, f, Context::Nonholonomic))
         .collect();
-    let contact_rows = contacts::translate(&mut tr, model);
+    let mut contact_rows = contacts::translate(&mut tr, model);
     drop(tr);
     let mut body_level = body_level;
     let (mut kinetic, mut potential) = (kinetic, potential);
@@ -223,6 +227,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 *r += nh0;
             }
         }
+        contact_rows.extend(bl.contacts.drain(..).map(Some));
         holonomic.extend(bl.holonomic.drain(..).map(Some));
         nonholonomic.extend(bl.nonholonomic.drain(..).map(Some));
         kinetic = kinetic.map(|k| g.add(vec![k, bl.kinetic]));
@@ -472,6 +477,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let contacts = contacts::derive(cx, model, g, contact_rows, &param_defaults, checking)?;
     let mut derived = Derived {
         contacts,
+        data,
         holonomic_names,
         nonholonomic_names,
         bodies: body_level,

@@ -6,6 +6,7 @@
 //! (the trait's default fills zeros). Runtime paths go through `::pfaff::__private`.
 
 mod contacts;
+mod data;
 pub mod expr;
 
 use std::collections::HashSet;
@@ -36,6 +37,9 @@ struct ModelNames {
     input_prefix: String,
     /// The local array of temporaries of long functions.
     temps: String,
+    /// Per data slot: its field name, the prefix of its entries' names, its offset and
+    /// length in the flat data.
+    data: Vec<(Ident, String, usize, usize)>,
 }
 
 /// `name` without the `r#` of a raw identifier, the text generated names are built on.
@@ -93,7 +97,22 @@ impl ModelNames {
         }) {
             input_prefix.push('_');
         }
+        let data = model
+            .data
+            .iter()
+            .map(|d| {
+                let mut prefix = format!("{}_", plain(&d.name));
+                while declared.iter().any(|n| {
+                    n.strip_prefix(prefix.as_str())
+                        .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+                }) {
+                    prefix.push('_');
+                }
+                (d.name.clone(), prefix, d.offset, d.len)
+            })
+            .collect();
         ModelNames {
+            data,
             coords: model.coords.iter().map(|c| c.name.clone()).collect(),
             velocities,
             params: model.params.iter().map(|p| p.name.clone()).collect(),
@@ -106,6 +125,20 @@ impl ModelNames {
     }
 }
 
+impl ModelNames {
+    /// The slot's field, its entries' name prefix and the index in the slot of entry `i`
+    /// of the flat data.
+    fn data_entry(&self, i: u32) -> (&Ident, &str, usize) {
+        let i = i as usize;
+        let (field, prefix, offset, _) = self
+            .data
+            .iter()
+            .find(|(_, _, o, len)| (*o..o + len).contains(&i))
+            .expect("data entries belong to a slot");
+        (field, prefix, i - offset)
+    }
+}
+
 impl Names for ModelNames {
     fn var(&self, v: Var) -> Ident {
         match v {
@@ -115,6 +148,10 @@ impl Names for ModelNames {
             Var::Param(i) => self.params[i as usize].clone(),
             Var::Delta(i) => format_ident!("delta_{}", plain(&self.coords[i as usize])),
             Var::Input(i) => format_ident!("{}{}", self.input_prefix, i),
+            Var::Data(i) => {
+                let (_, prefix, k) = self.data_entry(i);
+                format_ident!("{}{}", prefix, k)
+            }
         }
     }
     fn temp(&self, k: usize) -> Ident {
@@ -161,6 +198,11 @@ fn body(
                 let inputs = Ident::new(&names.inputs, Span::call_site());
                 let i = Literal::u32_unsuffixed(*i);
                 quote!(let #name = #inputs[#i];)
+            }
+            Var::Data(i) => {
+                let (field, _, k) = names.data_entry(*i);
+                let k = Literal::usize_unsuffixed(k);
+                quote!(let #name = self.data.#field[#k];)
             }
         });
     }
@@ -446,6 +488,74 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         }
     };
 
+    let data = data::data(g, &names, model, d);
+    let (set, model_def, data_info, data_items) = match &data {
+        None => (
+            set,
+            quote! {
+                #[doc = #model_doc]
+                #[derive(Clone, Copy, Debug, Default, PartialEq)]
+                pub struct Model {
+                    /// The parameter values.
+                    pub params: Params,
+                }
+
+                impl Model {
+                    /// The mechanism with the given parameters.
+                    #[must_use]
+                    pub const fn new(params: Params) -> Self {
+                        Self { params }
+                    }
+                }
+            },
+            quote!(&[]),
+            quote!(),
+        ),
+        Some(dc) => {
+            let set = if dc.refresh && param_count > 0 {
+                quote! {
+                    #set;
+                    let _ = self.refresh_data();
+                }
+            } else {
+                set
+            };
+            fns.extend(dc.fns.clone());
+            (
+                set,
+                quote! {
+                    #[doc = #model_doc]
+                    #[derive(Clone, Copy, Debug, PartialEq)]
+                    pub struct Model {
+                        /// The parameter values.
+                        pub params: Params,
+                        /// The run-time data (`Info::data`).
+                        pub data: Data,
+                    }
+
+                    impl Model {
+                        /// The mechanism with the given parameters, its data computed
+                        /// from them where it follows from them (`refresh_data`) and zero
+                        /// elsewhere.
+                        #[must_use]
+                        pub fn new(params: Params) -> Self {
+                            let mut model = Self { params, data: Data::default() };
+                            let _ = model.refresh_data();
+                            model
+                        }
+                    }
+
+                    impl ::core::default::Default for Model {
+                        fn default() -> Self {
+                            Self::new(Params::default())
+                        }
+                    }
+                },
+                dc.info.clone(),
+                dc.items.clone(),
+            )
+        }
+    };
     let mod_doc = doc_attr(docs);
     quote! {
         #(#attrs)*
@@ -463,20 +573,9 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 }
             }
 
-            #[doc = #model_doc]
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Model {
-                /// The parameter values.
-                pub params: Params,
-            }
+            #model_def
 
-            impl Model {
-                /// The mechanism with the given parameters.
-                #[must_use]
-                pub const fn new(params: Params) -> Self {
-                    Self { params }
-                }
-            }
+            #data_items
 
             #[doc = #info_doc]
             pub static INFO: ::pfaff::__private::Info = ::pfaff::__private::Info {
@@ -499,7 +598,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
                 conservative: #conservative,
                 outputs: #outputs,
                 #contact_info
-                data: &[],
+                data: #data_info,
                 linearization: #linearization,
                 #structure
             };
@@ -681,7 +780,7 @@ fn body_level(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStream)
 /// The trait methods `drawing` (the static shapes) and `drawing_values` (the points'
 /// global coordinates, then the scalars), when the model has shapes.
 fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut) -> TokenStream {
-    if d.shapes.is_empty() {
+    if d.shapes.is_empty() && d.up.is_none() {
         return TokenStream::new();
     }
     let opt = |x: Option<u32>| match x {
@@ -707,6 +806,7 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
         })
     });
     let scalars = u32::try_from(d.scalars.len()).expect("drawing size fits u32");
+    let up = opt(d.up);
     let mut roots: Vec<ExprId> = d
         .points
         .iter()
@@ -720,6 +820,7 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
                 points: &[#(#points),*],
                 scalars: #scalars,
                 shapes: &[#(#shapes),*],
+                up: #up,
             };
             &DRAWING
         }

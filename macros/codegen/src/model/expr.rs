@@ -146,6 +146,20 @@ impl<'a> Translator<'a> {
         self.model.nq()
     }
 
+    /// The index of the parameter called `name`.
+    pub fn param_index(&self, name: &str) -> Option<u32> {
+        self.model.param_index(name)
+    }
+
+    /// The names of the parameters.
+    pub fn param_names(&self) -> Vec<String> {
+        self.model
+            .params
+            .iter()
+            .map(|p| p.name.to_string())
+            .collect()
+    }
+
     /// Translates a value in context `ctx` with no local bindings (a declaration's field).
     pub fn field_value(&mut self, e: &syn::Expr, ctx: Context) -> Option<Value> {
         self.with_locals(ctx, &[], |t| t.value(e))
@@ -335,6 +349,44 @@ impl<'a> Translator<'a> {
         Some(id)
     }
 
+    /// `slot[i]` of a run-time data slot: `None` when `e` does not index a data slot,
+    /// `Some(None)` after an error.
+    pub(super) fn data_entry(&mut self, e: &syn::ExprIndex) -> Option<Option<ExprId>> {
+        let syn::Expr::Path(p) = &*e.expr else {
+            return None;
+        };
+        let name = p.path.get_ident()?.to_string();
+        if self.local(&name).is_some() {
+            return None;
+        }
+        let slot = self.model.data_slot(&name)?;
+        let (offset, len) = (slot.offset, slot.len);
+        if let Context::ParamDefault(_) = self.ctx {
+            self.cx.error_spanned_by(
+                e,
+                format!("run-time data `{name}` in a parameter default: only parameters and constants are allowed here"),
+            );
+            return Some(None);
+        }
+        if let syn::Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) = &*e.index
+        {
+            if let Ok(k) = i.base10_parse::<usize>() {
+                if k < len {
+                    let v = u32::try_from(offset + k).expect("data size fits u32");
+                    return Some(Some(self.g.var(Var::Data(v))));
+                }
+            }
+        }
+        self.cx.error_spanned_by(
+            &e.index,
+            format!("the index into `{name}` is an integer literal below its length {len}"),
+        );
+        Some(None)
+    }
+
     /// A scalar expression that is not a sum, product or negation (those go through
     /// [`Translator::value`]): a literal, a name, a function call or method.
     pub(super) fn scalar_leaf(&mut self, e: &syn::Expr) -> Option<ExprId> {
@@ -464,6 +516,13 @@ impl<'a> Translator<'a> {
                 return None;
             }
             return Some(self.g.var(Var::Q(i)));
+        }
+        if self.model.data_slot(&s).is_some() {
+            self.cx.error_spanned_by(
+                ident,
+                format!("`{s}` is an array of run-time data: read one value, e.g. `{s}[0]`"),
+            );
+            return None;
         }
         if let Some(i) = self.model.param_index(&s) {
             if let Context::ParamDefault(me) = self.ctx {

@@ -5,6 +5,7 @@
 //! exactly one kinetic-energy description, forces on existing coordinates. Expressions
 //! stay as `syn` trees here; [`expr`] translates them into the symbolic graph.
 
+pub mod data;
 pub mod expr;
 pub mod value;
 
@@ -59,6 +60,9 @@ pub struct Model {
     pub decls: Vec<Decl>,
     /// `#[mechanism(linearize)]`: emit the linearization Jacobian.
     pub linearize: bool,
+    /// Run-time data slots, in declaration order, with their offsets in the model's
+    /// flat data (`Var::Data`).
+    pub data: Vec<data::DataDecl>,
 }
 
 impl Model {
@@ -93,6 +97,10 @@ impl Model {
             .position(|c| c.name == name)
             .map(|i| u32::try_from(i).expect("coordinate count fits u32"))
     }
+    /// The data slot called `name`.
+    pub fn data_slot(&self, name: &str) -> Option<&data::DataDecl> {
+        self.data.iter().find(|d| d.name == name)
+    }
     /// Index of the parameter called `name`.
     pub fn param_index(&self, name: &str) -> Option<u32> {
         self.params
@@ -123,6 +131,7 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
         contacts: Vec::new(),
         decls: Vec::new(),
         linearize: ast.linearize,
+        data: Vec::new(),
     };
     let mut seen: HashMap<String, syn::Ident> = HashMap::new();
     let mut declare = |name: &syn::Ident| {
@@ -168,6 +177,13 @@ pub fn lower(cx: &Ctxt, ast: parse::Mechanism) -> Model {
             parse::Item::Decl(d) => {
                 declare(&d.name);
                 model.decls.push(d);
+            }
+            parse::Item::Data { name, docs, expr } => {
+                declare(&name);
+                let offset = model.data.last().map_or(0, |d| d.offset + d.len);
+                if let Some(d) = data::lower(cx, name, docs, &expr, offset) {
+                    model.data.push(d);
+                }
             }
             parse::Item::Fn(f) => {
                 if f.name == kw::DELTA {

@@ -378,6 +378,9 @@ impl Translator<'_> {
             syn::Expr::Binary(b) => self.binary(b),
             syn::Expr::Lit(_) => self.scalar_leaf(e).map(Value::Scalar),
             syn::Expr::Index(i) => {
+                if let Some(x) = self.data_entry(i) {
+                    return x.map(Value::Scalar);
+                }
                 let v = self.value(&i.expr)?;
                 let Value::Vector(c) = v else {
                     self.cx.error_spanned_by(

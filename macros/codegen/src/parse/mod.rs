@@ -44,7 +44,14 @@ pub enum Item {
     },
     /// A function item with its role.
     Fn(FnItem),
-    /// `static name: Frame|Point|Body|Joint|Force|Drawing = <constructor>;`, a declaration of
+    /// `static name: Data = Data { len: N } | Beam { .. };`, an array of run-time data
+    /// (`model::data`).
+    Data {
+        name: syn::Ident,
+        docs: String,
+        expr: syn::Expr,
+    },
+    /// `static name: Frame|Point|Body|Joint|Force|Drawing|Contact = <constructor>;`, a declaration of
     /// the body level.
     Decl(Decl),
 }
@@ -59,6 +66,9 @@ pub enum DeclKind {
     Force,
     /// A shape to draw (`pfaff::Drawing`).
     Drawing,
+    /// A contact between a point and a surface (`PointPlane`, `PointSphere`), compiled to
+    /// a gap function like `#[contact(e)] fn`.
+    Contact,
 }
 
 /// A body-level declaration: its kind, name and constructor expression.
@@ -198,10 +208,18 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 (kw::JOINT, DeclKind::Joint),
                 (kw::FORCE_ELEMENT, DeclKind::Force),
                 (kw::DRAWING, DeclKind::Drawing),
+                (kw::CONTACT_ITEM, DeclKind::Contact),
             ]
             .into_iter()
             .find(|(n, _)| is_type(&s.ty, n))
             .map(|(_, k)| k);
+            if is_type(&s.ty, kw::DATA) {
+                return Some(Item::Data {
+                    name: s.ident,
+                    docs,
+                    expr: *s.expr,
+                });
+            }
             if let Some(kind) = kind {
                 return Some(Item::Decl(Decl {
                     kind,
@@ -214,7 +232,8 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 cx.error_spanned_by(
                     &s.ty,
                     "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
-                     a `Point`, a `Body`, a `Joint`, a `Force` or a `Drawing`",
+                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing`, a `Contact` or \
+                     run-time `Data`",
                 );
                 return None;
             }

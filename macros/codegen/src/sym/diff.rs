@@ -124,7 +124,8 @@ pub fn for_each_partial(
             | (Var::Qd(_), Var::Qd(j))
             | (Var::Delta(_), Var::Delta(j))
             | (Var::Param(_), Var::Param(j))
-            | (Var::Input(_), Var::Input(j)) => j,
+            | (Var::Input(_), Var::Input(j))
+            | (Var::Data(_), Var::Data(j)) => j,
             _ => continue,
         };
         if j == 0 || j as usize >= n || var(j) != v {

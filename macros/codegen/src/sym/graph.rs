@@ -58,6 +58,9 @@ pub enum Var {
     /// Entry `i` of a vector the caller passes at run time (the accelerations and
     /// multipliers at which the linearization Jacobian is evaluated).
     Input(u32),
+    /// Entry `i` of the model's run-time data (its slots one after the other); a
+    /// constant of the motion, like a parameter.
+    Data(u32),
 }
 
 /// A node of the DAG.
@@ -105,6 +108,7 @@ impl Deps {
     pub const DELTA: Deps = Deps(8);
     pub const PARAM: Deps = Deps(16);
     pub const INPUT: Deps = Deps(32);
+    pub const DATA: Deps = Deps(64);
 
     /// The kind of a variable.
     pub fn of(v: Var) -> Deps {
@@ -115,6 +119,7 @@ impl Deps {
             Var::Delta(_) => Deps::DELTA,
             Var::Param(_) => Deps::PARAM,
             Var::Input(_) => Deps::INPUT,
+            Var::Data(_) => Deps::DATA,
         }
     }
     /// Whether any of the kinds in `other` is present.

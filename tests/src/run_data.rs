@@ -1,0 +1,207 @@
+//! Run-time data slots (`static name: Data = ..;`): a beam-element body's invariants
+//! computed by `pfaff::flex` from the parameters when the model is built and when a
+//! parameter changes, read by the generated code like parameters; slots set by the
+//! program with typed errors.
+
+use pfaff::flex::{Beam, Dim, Invariants, Reduction, Reference, Section};
+use pfaff::{DataError, Mechanism, MechanismExt};
+
+/// The spin-up beam of benchmark-models.md clamped in a fixed frame, reduced to its two
+/// lowest modes `p1, p2`, written with the slot's modal mass and stiffness (flat layout
+/// of `Invariants::write_flat` for d = 2, n = 2: `M_ff` at 35..39, `K_ff` at 39..43).
+#[pfaff::mechanism]
+mod clamped_beam {
+    /// Length [m].
+    const l: f64 = 10.0;
+    /// Axial stiffness [N].
+    const ea: f64 = 2.8e7;
+    /// Bending stiffness [N m²].
+    const ei: f64 = 1.4e4;
+    /// Mass per length [kg/m].
+    const rho_a: f64 = 1.2;
+    /// The beam's invariants: 8 elements, clamped at node 0, 2 modes.
+    static rod: Data = Beam {
+        elements: 8,
+        length: l,
+        rho_a,
+        ea,
+        ei,
+        modes: 2,
+        reference: Clamped,
+    };
+    /// Exported invariants of another body, set by the program.
+    static fe: Data = Data { len: 3 };
+    static p1: Coordinate = Coordinate { q0: 0.1 };
+    static p2: Coordinate = Coordinate {};
+    fn kinetic_energy() -> f64 {
+        0.5 * (rod[35] * p1.dot() * p1.dot()
+            + 2.0 * rod[36] * p1.dot() * p2.dot()
+            + rod[38] * p2.dot() * p2.dot())
+    }
+    fn potential_energy() -> f64 {
+        0.5 * (rod[39] * p1 * p1 + 2.0 * rod[40] * p1 * p2 + rod[42] * p2 * p2) + fe[0] * p1
+    }
+}
+
+fn reference_beam(ei: f64) -> Invariants {
+    Beam {
+        dim: Dim::Planar,
+        elements: 8,
+        length: 10.0,
+        section: Section::planar(1.2, 2.8e7, ei),
+        reference: Reference::Clamped { node: 0 },
+        reduction: Reduction::Modes(2),
+    }
+    .invariants()
+    .unwrap()
+}
+
+#[test]
+fn beam_slot_is_filled_from_the_parameters() {
+    let mut model = clamped_beam::Model::default();
+    let info = model.info();
+    assert_eq!(info.data.len(), 2);
+    assert_eq!((info.data[0].name, info.data[0].len), ("rod", 43));
+    assert_eq!(Invariants::flat_len(2, 2), 43);
+    assert_eq!((info.data[1].name, info.data[1].len), ("fe", 3));
+    let mut want = vec![0.0; 43];
+    reference_beam(1.4e4).write_flat(&mut want).unwrap();
+    assert_eq!(model.data(0), &want[..]);
+    assert_eq!(model.data(1), &[0.0; 3]);
+    // The generated mass matrix is the modal one (identity), the forces −K p with
+    // K = diag(ω1², ω2²), ω1 = 3.7977 rad/s (benchmark-models.md).
+    let mut m = [0.0; 4];
+    model.mass_matrix_dense_inplace(0.0, &[0.3, -0.2], &mut m);
+    for (k, x) in m.iter().enumerate() {
+        let want = if k % 3 == 0 { 1.0 } else { 0.0 };
+        assert!((x - want).abs() < 1e-12, "M[{k}] = {x}");
+    }
+    let mut f = [0.0; 2];
+    model.forces(0.0, &[1.0, 0.0], &[0.0, 0.0], &mut f);
+    assert!((-f[0] - 3.7977f64.powi(2)).abs() < 1e-3 * 14.42, "{f:?}");
+    assert!(f[1].abs() < 1e-9 * -f[0]);
+    // A parameter change recomputes the slot: ω² scales with EI.
+    model.set_parameter(2, 2.8e4);
+    reference_beam(2.8e4).write_flat(&mut want).unwrap();
+    assert_eq!(model.data(0), &want[..]);
+    let mut f2 = [0.0; 2];
+    model.forces(0.0, &[1.0, 0.0], &[0.0, 0.0], &mut f2);
+    assert!((f2[0] / f[0] - 2.0).abs() < 1e-12);
+    // A parameter that makes no beam fills the slot with NaN and says why.
+    let mut bad = model;
+    bad.set_parameter(2, -1.0);
+    assert!(bad.data(0).iter().all(|x| x.is_nan()));
+    assert!(matches!(
+        bad.refresh_data(),
+        Err(pfaff::flex::FlexError::Section { field: "ei_z", .. })
+    ));
+}
+
+#[test]
+fn program_slot_is_set_with_typed_errors() {
+    let mut model = clamped_beam::Model::default();
+    model.set_data(1, &[2.0, 0.0, 0.0]).unwrap();
+    assert_eq!(model.data(1), &[2.0, 0.0, 0.0]);
+    // `fe[0] p1` in V: a constant force −fe[0] on p1.
+    let mut f = [0.0; 2];
+    model.forces(0.0, &[0.0, 0.0], &[0.0, 0.0], &mut f);
+    assert!((f[0] + 2.0).abs() < 1e-12);
+    assert_eq!(
+        model.set_data(1, &[1.0]),
+        Err(DataError::Length {
+            slot: "fe",
+            expected: 3,
+            got: 1
+        })
+    );
+    assert_eq!(
+        model.set_data(1, &[1.0, f64::INFINITY, 0.0]),
+        Err(DataError::NotFinite {
+            slot: "fe",
+            index: 1,
+            value: f64::INFINITY
+        })
+    );
+    assert_eq!(
+        model.set_data(2, &[1.0]),
+        Err(DataError::NoSlot {
+            model: "clamped_beam",
+            index: 2
+        })
+    );
+    assert_eq!(model.data(1), &[2.0, 0.0, 0.0]);
+}
+
+/// A spatial beam reduced by Craig–Bampton and a simply supported planar one: the
+/// emitted calls build the same bodies as `pfaff::flex` called directly.
+#[pfaff::mechanism]
+mod beam_kinds {
+    const l: f64 = 2.0;
+    const rho_a: f64 = 3.0;
+    const ea: f64 = 5.0e4;
+    const gj: f64 = 20.0;
+    /// Spatial, clamped at node 0, the tip (node 4) as boundary and 2 fixed-interface
+    /// modes: 6 + 2 coordinates.
+    static arm: Data = SpatialBeam {
+        elements: 4,
+        length: l,
+        rho_a,
+        ea,
+        ei_y: 40.0,
+        ei_z: 90.0,
+        gj,
+        rho_iy: 1e-3,
+        rho_iz: 2e-3,
+        modes: 2,
+        boundary: [4],
+    };
+    /// Planar, simply supported between nodes 0 and 6, 3 modes.
+    static span: Data = Beam {
+        elements: 6,
+        length: 2.0 * l,
+        rho_a,
+        ea,
+        ei: 7.0,
+        modes: 3,
+        reference: SimplySupported,
+    };
+    static x: Coordinate = Coordinate {};
+    fn kinetic_energy() -> f64 {
+        0.5 * (arm[0] + span[0]) * x.dot().powi(2)
+    }
+}
+
+#[test]
+fn spatial_craig_bampton_and_simply_supported_slots() {
+    let model = beam_kinds::Model::default();
+    let arm = Beam {
+        dim: Dim::Spatial,
+        elements: 4,
+        length: 2.0,
+        section: Section::spatial(3.0, 5.0e4, 40.0, 90.0, 20.0, 1e-3, 2e-3),
+        reference: Reference::Clamped { node: 0 },
+        reduction: Reduction::CraigBampton {
+            boundary: vec![4],
+            modes: 2,
+        },
+    };
+    let span = Beam {
+        dim: Dim::Planar,
+        elements: 6,
+        length: 4.0,
+        section: Section::planar(3.0, 5.0e4, 7.0),
+        reference: Reference::SimplySupported { first: 0, last: 6 },
+        reduction: Reduction::Modes(3),
+    };
+    for (k, beam, d, n) in [(0, arm, 3, 8), (1, span, 2, 3)] {
+        assert_eq!(beam.coordinates(), n);
+        let mut want = vec![0.0; Invariants::flat_len(d, n)];
+        beam.invariants().unwrap().write_flat(&mut want).unwrap();
+        assert_eq!(model.info().data[k].len as usize, want.len());
+        assert_eq!(model.data(k), &want[..]);
+    }
+    // The kinetic energy reads the two masses: ρA (l + 2l).
+    let mut m = [0.0];
+    model.mass_matrix(0.0, &[0.0], &mut m);
+    assert!((m[0] - 3.0 * 6.0).abs() < 1e-12);
+}
