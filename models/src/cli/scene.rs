@@ -108,6 +108,7 @@ impl Scene {
                 span: "the test set's span",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "andrews" => Self {
                 t_end: 0.03,

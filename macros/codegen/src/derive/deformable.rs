@@ -25,7 +25,6 @@
 //! `ε = u' + ½ w'²`, i.e. the extra energy `s · ½ EA ∫ (u' w'² + ¼ w'⁴) dx`.
 
 use proc_macro2::Span;
-use syn::spanned::Spanned;
 
 use super::{fields, idx, BodyOut, Builder, Fields};
 use crate::derive::integrate::{integrate, XI};
@@ -109,6 +108,19 @@ fn closure(cx: &crate::ctxt::Ctxt, e: &syn::Expr) -> Option<Closure> {
         var: id.ident.to_string(),
         body: body.clone(),
     })
+}
+
+/// Where an error about a field points: the field's expression, or the constructor.
+#[derive(Clone, Copy)]
+struct At<'e>(Option<&'e syn::Expr>, Span);
+
+impl At<'_> {
+    fn error(self, cx: &crate::ctxt::Ctxt, msg: String) {
+        match self.0 {
+            Some(e) => cx.error_spanned_by(e, msg),
+            None => cx.error_at(self.1, msg),
+        }
+    }
 }
 
 impl Builder<'_, '_> {
@@ -241,12 +253,12 @@ impl Builder<'_, '_> {
         &mut self,
         e: ExprId,
         span: Option<(f64, f64)>,
-        at: Span,
+        at: At<'_>,
         what: &str,
     ) -> Option<ExprId> {
         let Some((a, b)) = span else {
-            self.cx.error_at(
-                at,
+            at.error(
+                self.cx,
                 format!("{what} is integrated over the material coordinate: give its range, e.g. `span: 0.0..1.0`"),
             );
             return None;
@@ -254,8 +266,8 @@ impl Builder<'_, '_> {
         match integrate(self.tr.g, e, a, b) {
             Ok(x) => Some(x),
             Err(msg) => {
-                self.cx.error_at(
-                    at,
+                at.error(
+                    self.cx,
                     format!("{what} cannot be integrated in closed form: it contains {msg}"),
                 );
                 None
@@ -476,7 +488,7 @@ impl Builder<'_, '_> {
     ) -> Option<Invariants> {
         let span = fl.span;
         // Where an integral that fails points: the closure that brought the bad term.
-        let field_span = |name: &str| fl.get(name).map_or(span, Spanned::span);
+        let field_span = |name: &str| At(fl.get(name), span);
         let (rho_at, pos_at, disp_at) = (
             field_span("density"),
             field_span("position"),
@@ -771,11 +783,11 @@ impl Builder<'_, '_> {
             }
             return Some(None);
         }
-        let at = fl.get("displacement").map_or(fl.span, Spanned::span);
-        let pos_at = fl.get("position").map_or(fl.span, Spanned::span);
+        let at = At(fl.get("displacement"), fl.span);
+        let pos_at = At(fl.get("position"), fl.span);
         let (Some(n), Some(pos)) = (sh.n.clone(), sh.position.clone()) else {
             self.cx.error_at(
-                at,
+                fl.span,
                 "a beam's stiffness is derived from `displacement` and `position`",
             );
             return None;
@@ -791,12 +803,12 @@ impl Builder<'_, '_> {
         };
         let xp = diff::differentiate(self.tr.g, pos[0], XI);
         if self.tr.g.depends_on(xp, XI) || self.tr.g.is_zero(xp) {
-            self.cx.error_at(pos_at, "a beam lies along its frame's x axis: `position: |xi| [l * xi, 0.0]` (x linear in the material coordinate)");
+            pos_at.error(self.cx, "a beam lies along its frame's x axis: `position: |xi| [l * xi, 0.0]` (x linear in the material coordinate)".into());
             return None;
         }
         for c in 1..dim {
             if self.tr.g.depends_on(pos[c], XI) {
-                self.cx.error_at(pos_at, "a beam lies along its frame's x axis: its position's other components are constant");
+                pos_at.error(self.cx, "a beam lies along its frame's x axis: its position's other components are constant".into());
                 return None;
             }
         }
