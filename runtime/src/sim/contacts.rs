@@ -479,7 +479,7 @@ pub(crate) fn refine<M: Mechanism + ?Sized>(
             break;
         }
         let next = te - g / rate;
-        if !(next > t0) || (next - te).abs() <= 4.0 * f64::EPSILON * te.abs() {
+        if next.is_nan() || next <= t0 || (next - te).abs() <= 4.0 * f64::EPSILON * te.abs() {
             break;
         }
         te = next;
