@@ -154,7 +154,8 @@ fn simulate_json_is_one_object_with_the_documented_keys() {
         .map(String::as_str)
         .collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["lambda", "outputs", "q", "qd", "qdd", "t"]);
+    assert_eq!(keys, ["joints", "lambda", "outputs", "q", "qd", "qdd", "t"]);
+    assert!(fin["joints"].is_null(), "pendulum has no joints");
     let (x, y) = (
         fin["q"]["x"].as_f64().unwrap(),
         fin["q"]["y"].as_f64().unwrap(),
