@@ -505,7 +505,13 @@ fn progress_bar_stays_hidden_when_stderr_is_not_a_terminal() {
 /// horizontal ones to m3·ẍ3 (Newton's second law; ẍ3 from the report's `qdd`).
 #[test]
 fn json_reports_joint_reactions_that_balance_on_the_slider() {
-    let out = pfaff(&["simulate", "slider_crank_bodies", "--t-end", "0.37", "--json"]);
+    let out = pfaff(&[
+        "simulate",
+        "slider_crank_bodies",
+        "--t-end",
+        "0.37",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
     let fin = &v["final"];
@@ -524,6 +530,11 @@ fn json_reports_joint_reactions_that_balance_on_the_slider() {
     }
     assert!(joints["driver"]["first"].is_null());
     // The text summary lists them too.
-    let text = stdout(&pfaff(&["simulate", "slider_crank_bodies", "--t-end", "0.37"]));
+    let text = stdout(&pfaff(&[
+        "simulate",
+        "slider_crank_bodies",
+        "--t-end",
+        "0.37",
+    ]));
     assert!(text.contains("joints") && text.contains("pin_b"), "{text}");
 }
