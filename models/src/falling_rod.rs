@@ -9,7 +9,8 @@
 /// $t^* = (v - \mathit{speed})/g$ (at $\mathit{gap}/\mathit{speed}$ when $g = 0$), with the
 /// normal impulse $\hat P = (1+e)\,m v/(1 + 3\cos^2\varphi)$, after which
 /// $\dot y^+ = -v + \hat P/m$ and $\dot\varphi^+ = -6\hat P\cos\varphi/(m l)$. Both ends
-/// are contacts.
+/// are contacts with the floor `y = 0`, written as points of the rod on a plane
+/// (`PointPlane`); their gaps are the ends' heights `y ∓ (l/2) sin φ`.
 #[pfaff::mechanism]
 pub mod falling_rod {
     /// Length [m].
@@ -37,23 +38,34 @@ pub mod falling_rod {
     /// Angle of the rod to the horizontal [rad].
     static phi: Coordinate = Coordinate { q0: angle };
 
-    fn kinetic_energy() -> f64 {
-        0.5 * m * (x.dot().powi(2) + y.dot().powi(2)) + m * l.powi(2) / 24.0 * phi.dot().powi(2)
-    }
-
-    fn potential_energy() -> f64 {
-        m * g * y
-    }
+    /// The rod: a uniform bar, its centre of mass at `(x, y)`, turned by `phi`.
+    static rod: Body = Body {
+        origin: [x, y],
+        angle: phi,
+        mass: m,
+        inertia: m * l.powi(2) / 12.0,
+    };
+    static gravity: Force = Gravity {
+        acceleration: [0.0, -g],
+    };
 
     /// The end at `−l/2` along the rod (the lower one at the start) above the floor.
-    #[contact(e)]
-    fn lower_end() -> f64 {
-        y - 0.5 * l * phi.sin()
-    }
+    static lower_end: Contact = PointPlane {
+        point: rod.point([-0.5 * l, 0.0]),
+        normal: [0.0, 1.0],
+        restitution: e,
+    };
 
     /// The end at `+l/2` along the rod above the floor.
-    #[contact(e)]
-    fn upper_end() -> f64 {
-        y + 0.5 * l * phi.sin()
-    }
+    static upper_end: Contact = PointPlane {
+        point: rod.point([0.5 * l, 0.0]),
+        normal: [0.0, 1.0],
+        restitution: e,
+    };
+
+    /// The rod as drawn: the bar between its ends.
+    static bar: Drawing = Link {
+        frame: rod,
+        points: [[-0.5 * l, 0.0], [0.5 * l, 0.0]],
+    };
 }

@@ -467,7 +467,7 @@ fn work_precision_table_csv_and_plot() {
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,
-        "formulation,method,rtol,error,rhs_evals,steps,jacobians,repartitions,wall_seconds,failure"
+        "formulation,method,rtol,error,impact_time_error,rhs_evals,steps,jacobians,repartitions,wall_seconds,failure"
     );
     assert_eq!(csv.lines().count(), 1 + 3 * 5 * 10);
     assert_svg(&dir.join("wp.svg"));

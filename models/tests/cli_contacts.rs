@@ -90,3 +90,34 @@ fn work_precision_on_impact_models() {
         assert!(checked >= 9, "{model}: {checked} rows at 1e-8 in\n{text}");
     }
 }
+
+/// `work-precision` on the impact models also reports the error of the impact times
+/// against their closed forms (`t_impact`: bouncing_ball t₁ = √(2h/g), t₂ = t₁(1 + 2e);
+/// falling_rod t* = (v − speed)/g, scene.rs), and it falls with the tolerance: within
+/// `rtol × span` on every row (the flights are polynomials, so the error is that of
+/// the event location, tied to the tolerance).
+#[test]
+fn work_precision_reports_impact_time_errors() {
+    for (model, span, impacts) in [("bouncing_ball", 1.0, 2), ("falling_rod", 0.08, 1)] {
+        let out = pfaff(&["work-precision", model]);
+        assert!(out.status.success(), "{model}");
+        let text = stdout(&out);
+        assert!(
+            text.contains(&format!("over the {impacts} impacts of the span")),
+            "{text}"
+        );
+        assert!(text.contains(" t_impact "), "{text}");
+        let mut checked = 0;
+        for line in text.lines() {
+            let cols: Vec<&str> = line.split_whitespace().collect();
+            if cols.len() < 5 || !["partitioning", "projection", "baumgarte"].contains(&cols[0]) {
+                continue;
+            }
+            let rtol: f64 = cols[2].parse().unwrap();
+            let err: f64 = cols[4].parse().unwrap();
+            assert!(err <= rtol * span + 1e-15, "{model}: {line}");
+            checked += 1;
+        }
+        assert_eq!(checked, 150, "{model}: rows in\n{text}");
+    }
+}

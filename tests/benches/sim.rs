@@ -44,6 +44,7 @@ fn pendulum_reference(t: f64) -> Reference {
     Reference {
         coordinates: vec![("x".into(), th.sin()), ("y".into(), -th.cos())],
         velocities: vec![("x".into(), th.cos() * thd), ("y".into(), th.sin() * thd)],
+        impacts: Vec::new(),
     }
 }
 
@@ -70,6 +71,7 @@ fn main() {
         let reference = Reference {
             coordinates: vec![("phi".into(), 0.176_360_706_663)],
             velocities: vec![("phi".into(), 0.035_719_741_683_2)],
+            impacts: Vec::new(),
         };
         let rows = work_precision(&sleigh::Model::default(), &Sweep::standard(1.0), &reference);
         println!("## sleigh, t = 1, math-spec V11\n\n{}", format_table(&rows));

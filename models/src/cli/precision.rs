@@ -31,6 +31,12 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
                     r.velocities.push((name.to_owned(), qd));
                 }
             }
+            if let Some(times) = scene.impact_times {
+                r.impacts = times(model.as_ref(), t_end)
+                    .into_iter()
+                    .map(|(c, t)| (c.to_owned(), t))
+                    .collect();
+            }
             (r, "the closed-form solution".to_owned())
         }
         None => {
@@ -57,6 +63,12 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference|, reference: {source}",
         entry.name
     );
+    if !reference.impacts.is_empty() {
+        println!(
+            "t_impact = largest |impact time - closed form| over the {} impacts of the span [s]",
+            reference.impacts.len()
+        );
+    }
     print!("{}", format_table(&rows));
     if let Some(path) = &args.csv {
         let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
@@ -66,6 +78,7 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             "method",
             "rtol",
             "error",
+            "impact_time_error",
             "rhs_evals",
             "steps",
             "jacobians",
@@ -80,6 +93,7 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
                 r.method.name().to_owned(),
                 r.rtol.to_string(),
                 r.error.to_string(),
+                r.impact_error.map(|e| e.to_string()).unwrap_or_default(),
                 r.rhs_evals.to_string(),
                 r.steps.to_string(),
                 r.jacobians.to_string(),

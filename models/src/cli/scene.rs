@@ -10,6 +10,9 @@ use pfaff::Mechanism;
 /// The reference solution of a model at time `t`: `(coordinates, velocities)` by name.
 pub type ClosedForm = fn(&dyn Mechanism, f64) -> Vec<(&'static str, f64, f64)>;
 
+/// The exact impact times of a model up to an end time: `(contact, t)`.
+pub type ImpactTimes = fn(&dyn Mechanism, f64) -> Vec<(&'static str, f64)>;
+
 /// A steady motion: coordinates set (the rest assembled), the coordinate whose velocity
 /// is the forward speed, and the coordinates that are ignorable in that motion.
 #[derive(Clone, Copy, Debug)]
@@ -43,6 +46,9 @@ pub struct Scene {
     pub steady: Option<Steady>,
     /// Exact solution from the default initial state, when there is one.
     pub closed_form: Option<ClosedForm>,
+    /// The exact impact times up to an end time, `(contact, t)` in time order, for
+    /// models with impacts and a closed form.
+    pub impact_times: Option<ImpactTimes>,
 }
 
 impl Scene {
@@ -53,6 +59,7 @@ impl Scene {
             span: "1 s",
             steady: None,
             closed_form: None,
+            impact_times: None,
         }
     }
 
@@ -73,36 +80,42 @@ impl Scene {
                     summary: "hanging at rest",
                 }),
                 closed_form: Some(pendulum_exact),
+                impact_times: None,
             },
             "chain10" => Self {
                 t_end: 0.5,
                 span: "the first swing down from the horizontal",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "chain100" => Self {
                 t_end: 0.01,
                 span: "a short span: 700 coordinates and 400 constraints per step",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "slider_crank" => Self {
                 t_end: std::f64::consts::TAU / 10.0,
                 span: "one crank revolution",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "andrews" => Self {
                 t_end: 0.03,
                 span: "the reference span of Hairer & Wanner",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "car_axis" => Self {
                 t_end: 3.0,
                 span: "the reference span",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "sleigh" => Self {
                 t_end: 5.0,
@@ -117,6 +130,7 @@ impl Scene {
                     summary: "straight motion along x",
                 }),
                 closed_form: Some(sleigh_exact),
+                impact_times: None,
             },
             "rolling_disk" => Self {
                 t_end: 5.0,
@@ -138,6 +152,7 @@ impl Scene {
                     summary: "upright rolling along x",
                 }),
                 closed_form: None,
+                impact_times: None,
             },
             "bicycle" => Self {
                 t_end: 5.0,
@@ -161,24 +176,28 @@ impl Scene {
                     summary: "upright straight running",
                 }),
                 closed_form: None,
+                impact_times: None,
             },
             "spatial_four_bar" => Self {
                 t_end: 2.0,
                 span: "2 s of swinging",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "bricard" => Self {
                 t_end: 10.0,
                 span: "the 10 s of the IFToMM A04 benchmark",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "seed2_example1" => Self {
                 t_end: 2.0,
                 span: "the span of math-spec V2",
                 steady: None,
                 closed_form: Some(seed2_example1_exact),
+                impact_times: None,
             },
             "parallelogram" => Self {
                 // Falling from θ = π/3, the cranks reach the horizontal at t ≈ 0.497 s:
@@ -190,36 +209,42 @@ impl Scene {
                 span: "the swing down to just before the horizontal dead-centre at 0.497 s",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "seed2_example2" => Self {
                 t_end: 1.0,
                 span: "the span of math-spec V4",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "bouncing_ball" => Self {
                 t_end: 1.0,
                 span: "the first two bounces; --t-end 2 shows the accumulation at 1.3546 s and the rest",
                 steady: None,
                 closed_form: Some(bouncing_ball_exact),
+                impact_times: Some(bouncing_ball_impacts),
             },
             "falling_rod" => Self {
                 t_end: 0.08,
                 span: "the first impact and the flight after it",
                 steady: None,
                 closed_form: Some(falling_rod_exact),
+                impact_times: Some(falling_rod_impacts),
             },
             "newtons_cradle" => Self {
                 t_end: 2.0,
                 span: "a few swings",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             "pendulum_floor" | "sleigh_wall" | "body_impact" | "two_body_impact" => Self {
                 t_end: 1.0,
                 span: "1 s from the impact of its math-spec case",
                 steady: None,
                 closed_form: None,
+                impact_times: None,
             },
             _ => Self::fallback(),
         }
@@ -250,6 +275,46 @@ fn bouncing_ball_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64,
     }
     let s = t - t_n;
     vec![("y", v * s - 0.5 * g * s * s, v - g * s)]
+}
+
+/// The bouncing ball's impacts up to `t_end` (see [`bouncing_ball_exact`]):
+/// $t_1 = T = \sqrt{2h/g}$, $t_{n+1} = t_n + 2 e^n T$ (the flight after impact `n`
+/// leaves at $e^n\sqrt{2gh}$), as long as the rebound speed is above $10^{-6}$ of the
+/// first impact's: the later ones accumulate at $t_\infty$ faster than a run resolves,
+/// and a run turns them into a resting contact.
+fn bouncing_ball_impacts(model: &dyn Mechanism, t_end: f64) -> Vec<(&'static str, f64)> {
+    let (h, e, g) = (
+        parameter(model, "h"),
+        parameter(model, "e"),
+        parameter(model, "g"),
+    );
+    let tt = (2.0 * h / g).sqrt();
+    let mut out = Vec::new();
+    let (mut t, mut en) = (tt, 1.0);
+    while t <= t_end && en >= 1e-6 {
+        out.push(("floor", t));
+        en *= e;
+        t += 2.0 * en * tt;
+    }
+    out
+}
+
+/// The falling rod's first impact, of its lower end at $t^*$ (see
+/// [`falling_rod_exact`]), when it comes before `t_end`.
+fn falling_rod_impacts(model: &dyn Mechanism, t_end: f64) -> Vec<(&'static str, f64)> {
+    let p = |n| parameter(model, n);
+    let (speed, gap, g) = (p("speed"), p("gap"), p("g"));
+    let v = (speed * speed + 2.0 * g * gap).sqrt();
+    let t_star = if g == 0.0 {
+        gap / speed
+    } else {
+        (v - speed) / g
+    };
+    if t_star <= t_end {
+        vec![("lower_end", t_star)]
+    } else {
+        Vec::new()
+    }
 }
 
 /// The falling rod (benchmark-models.md) up to its second impact: the lower end strikes

@@ -18,6 +18,9 @@ pub struct Reference {
     pub coordinates: Vec<(String, f64)>,
     /// `(coordinate, velocity)`.
     pub velocities: Vec<(String, f64)>,
+    /// `(contact, time)` of the impacts from the start, in time order, for models with
+    /// impacts whose times are known (a closed form); empty: not measured.
+    pub impacts: Vec<(String, f64)>,
 }
 
 impl Reference {
@@ -38,7 +41,45 @@ impl Reference {
         Self {
             coordinates: named(q),
             velocities: named(qd),
+            impacts: Vec::new(),
         }
+    }
+
+    /// The largest error of the impact times of `run` against [`impacts`](Self::impacts):
+    /// the `k`-th reference impact of a contact is compared with the `k`-th strike of
+    /// that contact in the run; a reference impact the run does not have is an infinite
+    /// error (a missed impact). Strikes after the listed ones are not compared (a
+    /// closed form lists the impacts it can resolve: the accumulating bounces of a
+    /// ball are finitely many to a run). `None` when there is nothing to compare.
+    #[must_use]
+    pub fn impact_time_error(&self, run: &Run) -> Option<f64> {
+        if self.impacts.is_empty() {
+            return None;
+        }
+        let mut err = 0.0_f64;
+        let mut seen: Vec<(&str, usize)> = Vec::new();
+        for (name, t) in &self.impacts {
+            let k = match seen.iter_mut().find(|(n, _)| n == name) {
+                Some((_, k)) => {
+                    *k += 1;
+                    *k
+                }
+                None => {
+                    seen.push((name, 0));
+                    0
+                }
+            };
+            let found = run
+                .impacts
+                .iter()
+                .filter(|i| i.names.contains(&name.as_str()))
+                .nth(k);
+            match found {
+                Some(i) => err = err.max((i.t - t).abs()),
+                None => return Some(f64::INFINITY),
+            }
+        }
+        Some(err)
     }
 
     /// The largest absolute difference between the final row of `run` and the
@@ -109,6 +150,9 @@ pub struct Row {
     pub rtol: f64,
     /// Final error against the reference (`NaN` when the run failed).
     pub error: f64,
+    /// Largest error of the impact times against the reference's
+    /// ([`Reference::impact_time_error`]); `None` when the reference has none.
+    pub impact_error: Option<f64>,
     /// Right-hand-side evaluations.
     pub rhs_evals: u64,
     /// Accepted steps.
@@ -162,6 +206,13 @@ pub fn work_precision<M: Mechanism + ?Sized>(
                     } else {
                         reference.error(&run)
                     },
+                    impact_error: reference.impact_time_error(&run).map(|e| {
+                        if failure.is_some() {
+                            f64::NAN
+                        } else {
+                            e
+                        }
+                    }),
                     rhs_evals: run.stats.rhs_evals,
                     steps: run.stats.steps,
                     jacobians: run.stats.jacobians,
@@ -179,19 +230,36 @@ pub fn work_precision<M: Mechanism + ?Sized>(
 #[must_use]
 pub fn format_table(rows: &[Row]) -> String {
     let mut s = String::new();
+    // The impact-time column only for sweeps that measure it.
+    let impacts = rows.iter().any(|r| r.impact_error.is_some());
+    let _ = write!(
+        s,
+        "{:<13} {:<7} {:>8} {:>10}",
+        "formulation", "method", "rtol", "error"
+    );
+    if impacts {
+        let _ = write!(s, " {:>10}", "t_impact");
+    }
     let _ = writeln!(
         s,
-        "{:<13} {:<7} {:>8} {:>10} {:>9} {:>8} {:>6} {:>6} {:>11}",
-        "formulation", "method", "rtol", "error", "rhs", "steps", "jac", "repart", "wall [ms]"
+        " {:>9} {:>8} {:>6} {:>6} {:>11}",
+        "rhs", "steps", "jac", "repart", "wall [ms]"
     );
     for r in rows {
         let _ = write!(
             s,
-            "{:<13} {:<7} {:>8.0e} {:>10.2e} {:>9} {:>8} {:>6} {:>6} {:>11.3}",
+            "{:<13} {:<7} {:>8.0e} {:>10.2e}",
             r.formulation.name(),
             r.method.name(),
             r.rtol,
             r.error,
+        );
+        if impacts {
+            let _ = write!(s, " {:>10.2e}", r.impact_error.unwrap_or(f64::NAN));
+        }
+        let _ = write!(
+            s,
+            " {:>9} {:>8} {:>6} {:>6} {:>11.3}",
             r.rhs_evals,
             r.steps,
             r.jacobians,

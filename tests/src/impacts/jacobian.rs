@@ -32,6 +32,72 @@ pub mod moving_floor {
     }
 }
 
+/// A test-only model with the body level's contacts: a point of `b1` on a tilted plane
+/// that rises with time (a non-unit normal, an offset, a radius), and a point of `b1`
+/// outside a disc about `b2`'s centre.
+#[pfaff::mechanism]
+pub mod surfaces {
+    const e: f64 = 0.6;
+    const rise: f64 = 0.1;
+    static x1: Coordinate = Coordinate { q0: 0.1 };
+    static y1: Coordinate = Coordinate { q0: 1.0 };
+    static phi1: Coordinate = Coordinate { q0: 0.3 };
+    static x2: Coordinate = Coordinate { q0: 1.0 };
+    static y2: Coordinate = Coordinate { q0: 0.5 };
+    static phi2: Coordinate = Coordinate {};
+    static b1: Body = Body {
+        origin: [x1, y1],
+        angle: phi1,
+        mass: 1.0,
+        inertia: 0.1,
+    };
+    static b2: Body = Body {
+        origin: [x2, y2],
+        angle: phi2,
+        mass: 2.0,
+        inertia: 0.2,
+    };
+    /// `b1`'s point `(0.3, 0.1)`, a ball of radius 0.05, above the plane
+    /// `(0.5, 2)·x/|(0.5, 2)| = rise·t`.
+    static tilted: Contact = PointPlane {
+        point: b1.point([0.3, 0.1]),
+        normal: [0.5, 2.0],
+        offset: rise * t,
+        radius: 0.05,
+        restitution: e,
+    };
+    /// `b1`'s point `(0.3, 0)` outside the disc of radius 0.2 about `b2`'s centre.
+    static ball: Contact = PointSphere {
+        point: b1.point([0.3, 0.0]),
+        center: b2.origin(),
+        radius: 0.2,
+        restitution: e,
+    };
+}
+
+/// The gaps of `PointPlane` and `PointSphere` are the signed distances, written out by
+/// hand: `n̂·p − offset − radius` and `|p − c| − radius`.
+#[test]
+fn body_level_gaps_are_signed_distances() {
+    let model = surfaces::Model::default();
+    let info = model.info();
+    assert_eq!(info.ncontacts(), 2);
+    let mut rng = Rng::new(5);
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..6).map(|_| rng.range(-1.0, 1.0)).collect();
+        let t = rng.range(0.0, 2.0);
+        let g = gaps(&model, t, &q);
+        let (s, c) = q[2].sin_cos();
+        let (px, py) = (q[0] + 0.3 * c - 0.1 * s, q[1] + 0.3 * s + 0.1 * c);
+        let n = (0.25f64 + 4.0).sqrt();
+        let tilted = (0.5 * px + 2.0 * py) / n - 0.1 * t - 0.05;
+        let (bx, by) = (q[0] + 0.3 * c, q[1] + 0.3 * s);
+        let ball = ((bx - q[3]).powi(2) + (by - q[4]).powi(2)).sqrt() - 0.2;
+        assert!((g[0] - tilted).abs() < 1e-14, "{} vs {tilted}", g[0]);
+        assert!((g[1] - ball).abs() < 1e-14, "{} vs {ball}", g[1]);
+    }
+}
+
 #[test]
 fn contact_jacobians_match_finite_differences() {
     let mut rng = Rng::new(11);
@@ -41,7 +107,12 @@ fn contact_jacobians_match_finite_differences() {
         summary: "",
         make: || Box::new(moving_floor::Model::default()),
     };
-    for entry in pfaff_models::all().iter().chain([&extra]) {
+    let surfaces = pfaff_models::Entry {
+        name: "surfaces",
+        summary: "",
+        make: || Box::new(surfaces::Model::default()),
+    };
+    for entry in pfaff_models::all().iter().chain([&extra, &surfaces]) {
         let model = (entry.make)();
         let info = model.info();
         let (n, nc) = (info.nq(), info.ncontacts());

@@ -111,7 +111,8 @@ fn radau5_takes_orders_of_magnitude_fewer_steps_on_a_stiff_mechanism() {
             e
         };
         let e_imp = row("radau5", &implicit);
-        assert!(e_imp < 100.0 * rtol, "radau5 at {rtol}: error {e_imp}");
+        // Tolerance proportionality (issue 8's band): measured 2.2, 8.0, 0.2 × rtol.
+        assert!(e_imp < 20.0 * rtol, "radau5 at {rtol}: error {e_imp}");
         for method in [Method::Dopri5, Method::Dop853] {
             let explicit = run(method, rtol);
             let e = row(method.name(), &explicit);

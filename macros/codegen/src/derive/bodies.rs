@@ -19,6 +19,7 @@ use proc_macro2::Span;
 use quote::ToTokens;
 use syn::spanned::Spanned;
 
+use super::contacts::ContactRow;
 use super::drawing::{Attachment, DrawingOut, UserShape, DRAWING_KINDS};
 use super::Row;
 use crate::ctxt::{suggest, Ctxt};
@@ -92,6 +93,8 @@ pub struct BodyLevel {
     pub point_roots: Vec<ExprId>,
     /// How the model is drawn.
     pub drawing: DrawingOut,
+    /// Contacts between points and surfaces (`Contact` items), as gaps.
+    pub contacts: Vec<ContactRow>,
 }
 
 fn idx(i: usize) -> u32 {
@@ -232,6 +235,20 @@ const JOINT_KINDS: &[(&str, &[&str], &[&str])] = &[
     ("KnifeEdge", &["a", "lateral"], &["at_a"]),
     ("RollingWheel", &["a", "axis", "radius"], &["center", "up"]),
 ];
+/// Contacts between a point and a surface: the gap is the signed distance, positive
+/// apart.
+const CONTACT_KINDS: &[(&str, &[&str], &[&str])] = &[
+    (
+        "PointPlane",
+        &["point", "normal", "restitution"],
+        &["offset", "radius"],
+    ),
+    (
+        "PointSphere",
+        &["point", "center", "radius", "restitution"],
+        &[],
+    ),
+];
 const FORCE_KINDS: &[(&str, &[&str], &[&str])] = &[
     ("Gravity", &["acceleration"], &[]),
     (
@@ -286,6 +303,7 @@ pub fn expand<'a>(
             poses: Vec::new(),
             point_roots: Vec::new(),
             drawing: DrawingOut::default(),
+            contacts: Vec::new(),
         },
         kinetic: Vec::new(),
         potential: Vec::new(),
@@ -304,6 +322,7 @@ pub fn expand<'a>(
             DeclKind::Joint => b.joint(d),
             DeclKind::Force => b.force(d),
             DeclKind::Drawing => b.drawing(d),
+            DeclKind::Contact => b.contact(d),
         };
         ok &= done.is_some();
         if done.is_none() && matches!(d.kind, DeclKind::Frame | DeclKind::Body) {
@@ -1189,6 +1208,129 @@ impl<'a> Builder<'_, 'a> {
             normal,
             radius,
             color,
+        });
+        Some(())
+    }
+
+    /// A vector field of a `Contact` item (global coordinates), of the dimension of the
+    /// item's first vector.
+    fn contact_vector(&mut self, e: &syn::Expr, dim: &mut Option<usize>) -> Option<Vec<ExprId>> {
+        match self.tr.field_value(e, Context::Kinematics)? {
+            Value::Vector(v) if matches!(v.len(), 2 | 3) && dim.is_none_or(|d| d == v.len()) => {
+                *dim = Some(v.len());
+                Some(v)
+            }
+            other => {
+                let want = dim.map_or("a 2- or 3-vector".to_owned(), |d| format!("a {d}-vector"));
+                self.cx
+                    .error_spanned_by(e, format!("expected {want}; this is {}", other.describe()));
+                None
+            }
+        }
+    }
+
+    /// `static name: Contact = PointPlane { point, normal, restitution, offset?, radius? }`
+    /// (the gap `n̂·p − offset − radius`: a point, or a ball of `radius` about it, above
+    /// the plane `n̂·x = offset`) or `PointSphere { point, center, radius, restitution }`
+    /// (the gap `|p − c| − radius`: a point outside a sphere, a disc in a planar model).
+    /// The vectors are global and may be expressions of the coordinates and time (a body
+    /// point `rod.point([..])`, another body's centre), not of the velocities; the
+    /// restitution is a parameter's name. A plane fixed in the ground is drawn.
+    fn contact(&mut self, d: &Decl) -> Option<()> {
+        let fl = fields(self.cx, &d.expr, CONTACT_KINDS, "contact")?;
+        let re = fl.get("restitution")?;
+        let name = match re {
+            syn::Expr::Path(p) => p.path.get_ident().map(ToString::to_string),
+            _ => None,
+        };
+        let Some(name) = name else {
+            self.cx.error_spanned_by(
+                re,
+                "the coefficient of restitution is the name of a parameter, e.g. \
+                 `restitution: e` with `const e: f64 = 0.5;`",
+            );
+            return None;
+        };
+        let Some(restitution) = self.tr.param_index(&name) else {
+            let names = self.tr.param_names();
+            let hint = suggest(&name, names.iter().map(String::as_str))
+                .map(|s| format!("; did you mean `{s}`?"))
+                .unwrap_or_default();
+            self.cx.error_spanned_by(
+                re,
+                format!(
+                    "`restitution: {name}` names no parameter: the coefficient of restitution \
+                     is a parameter (`const {name}: f64 = 0.5;`){hint}"
+                ),
+            );
+            return None;
+        };
+        let mut dim = None;
+        let p = self.contact_vector(fl.get("point")?, &mut dim)?;
+        let zero = self.g().constant(0.0);
+        let opt_scalar = |b: &mut Self, key: &str| match fl.get(key) {
+            Some(e) => b.scalar(e, Context::Kinematics),
+            None => Some(zero),
+        };
+        let gap = if fl.kind == "PointPlane" {
+            let ne = fl.get("normal")?;
+            let n = self.contact_vector(ne, &mut dim)?;
+            let nn = dot(self.g(), &n, &n);
+            if self.g().is_zero(nn) {
+                self.cx
+                    .error_spanned_by(ne, "the normal of a contact plane is the zero vector");
+                return None;
+            }
+            let len = self.g().call(Func::Sqrt, nn);
+            let offset = opt_scalar(self, "offset")?;
+            let radius = opt_scalar(self, "radius")?;
+            let np = dot(self.g(), &n, &p);
+            let dist = self.g().div(np, len);
+            let off = self.g().add(vec![offset, radius]);
+            let gap = self.g().sub(dist, off);
+            // A plane fixed in the ground is drawn, like a guide.
+            let fixed = [&n[..], &[offset]].concat().iter().all(|&x| {
+                let deps = self.tr.g.deps(x);
+                !deps.has(Deps::Q) && !deps.has(Deps::TIME) && !deps.has(Deps::QD)
+            });
+            if fixed {
+                let inv = self.g().div(offset, len);
+                let unit: Vec<ExprId> = n.iter().map(|&x| self.g().div(x, len)).collect();
+                let at = scale_v(self.g(), inv, &unit);
+                self.attachments.push(Attachment::Guide {
+                    name: d.name.to_string(),
+                    point: at,
+                    normal: unit,
+                });
+            }
+            gap
+        } else {
+            let c = self.contact_vector(fl.get("center")?, &mut dim)?;
+            let radius = self.scalar(fl.get("radius")?, Context::Kinematics)?;
+            let r = sub_v(self.g(), &p, &c);
+            let rr = dot(self.g(), &r, &r);
+            let dist = self.g().call(Func::Sqrt, rr);
+            self.g().sub(dist, radius)
+        };
+        if self.tr.g.deps(gap).has(Deps::QD) {
+            self.cx.error_at(
+                fl.span,
+                format!(
+                    "contact `{}`: a gap depends on the coordinates and time, not on velocities",
+                    d.name
+                ),
+            );
+            return None;
+        }
+        self.out.contacts.push(ContactRow {
+            row: Row {
+                name: d.name.to_string(),
+                docs: d.docs.clone(),
+                span: d.name.span(),
+                expr: gap,
+            },
+            restitution,
+            restitution_span: re.span(),
         });
         Some(())
     }

@@ -1,8 +1,10 @@
-//! Contacts: `#[contact(e)] fn name() -> f64 { gap }` → the gap, its normal Jacobian and
-//! what resting contact needs (math-spec §7).
+//! Contacts: `#[contact(e)] fn name() -> f64 { gap }` and the body level's
+//! `static name: Contact = PointPlane { .. }` (`PointSphere`) → the gap, its normal
+//! Jacobian and what resting contact needs (math-spec §7).
 //!
 //! Input: the model's contact items, translated in [`Context::Contact`] (coordinates,
-//! parameters and time; no velocities). Output: per contact the gap $\delta(q, t)$, its
+//! parameters and time; no velocities), then the body level's contacts, whose gaps the
+//! body level wrote as the signed distance of a point to a surface. Output: per contact the gap $\delta(q, t)$, its
 //! time partial $\delta_t$ and $\gamma_c = -(D\dot q)_q\dot q - 2D_t\dot q - \delta_{tt}$
 //! (so that $D\ddot q = \gamma_c$ keeps a closed contact closed, as $\gamma_h$ does for a
 //! holonomic row), and the normal Jacobian $D = \partial\delta/\partial q$ with its
@@ -11,6 +13,8 @@
 //! Checks: a restitution parameter whose default lies outside $[0, 1]$, a gap that
 //! does not depend on the coordinates (no motion can close it) are
 //! spanned errors, and so is a derived constant that is not finite.
+
+use proc_macro2::Span;
 
 use super::{checks, idx, Entry, Row};
 use crate::ctxt::Ctxt;
@@ -41,18 +45,38 @@ pub struct Contacts {
     pub jacobian: Vec<Entry>,
 }
 
+/// A contact to derive: its gap and its restitution parameter, from a `#[contact(e)]`
+/// function or a body-level `Contact` item.
+#[derive(Clone, Debug)]
+pub struct ContactRow {
+    /// The gap, named.
+    pub row: Row,
+    /// Index of the restitution parameter.
+    pub restitution: u32,
+    /// The tokens naming it, for errors.
+    pub restitution_span: Span,
+}
+
 /// Translates the gap functions (while the translator is alive).
-pub fn translate(tr: &mut Translator<'_>, model: &Model) -> Vec<Option<Row>> {
+pub fn translate(tr: &mut Translator<'_>, model: &Model) -> Vec<Option<ContactRow>> {
     model
         .contacts
         .iter()
-        .map(|(_, f)| {
+        .map(|(e, f)| {
             let expr = tr.block(&f.block, Context::Contact)?;
-            Some(Row {
-                name: f.name.to_string(),
-                docs: f.docs.clone(),
-                span: f.name.span(),
-                expr,
+            let restitution_span = match &f.role {
+                crate::parse::Role::Contact(ident) => ident.span(),
+                _ => f.name.span(),
+            };
+            Some(ContactRow {
+                row: Row {
+                    name: f.name.to_string(),
+                    docs: f.docs.clone(),
+                    span: f.name.span(),
+                    expr,
+                },
+                restitution: *e,
+                restitution_span,
             })
         })
         .collect()
@@ -63,7 +87,7 @@ pub fn derive(
     cx: &Ctxt,
     model: &Model,
     g: &mut Graph,
-    rows: Vec<Option<Row>>,
+    rows: Vec<Option<ContactRow>>,
     param_defaults: &[f64],
     checking: bool,
 ) -> Option<Contacts> {
@@ -72,24 +96,33 @@ pub fn derive(
     let qd_pairs: Vec<(Var, ExprId)> = (0..n).map(|i| (Var::Q(idx(i)), qv[i])).collect();
     let mut out = Contacts::default();
     let mut ok = true;
-    for (e, f) in &model.contacts {
-        let v = param_defaults.get(*e as usize).copied().unwrap_or(0.0);
+    for c in rows.iter().flatten() {
+        let v = param_defaults
+            .get(c.restitution as usize)
+            .copied()
+            .unwrap_or(0.0);
         if checking && !(0.0..=1.0).contains(&v) {
-            if let crate::parse::Role::Contact(ident) = &f.role {
-                cx.error_spanned_by(
-                    ident,
-                    format!(
-                        "the coefficient of restitution `{ident}` of contact `{}` defaults to \
-                         {v}, outside [0, 1]",
-                        f.name
-                    ),
-                );
-            }
+            let e = model
+                .params
+                .get(c.restitution as usize)
+                .map(|p| p.name.to_string())
+                .unwrap_or_default();
+            cx.error_at(
+                c.restitution_span,
+                format!(
+                    "the coefficient of restitution `{e}` of contact `{}` defaults to {v}, \
+                     outside [0, 1]",
+                    c.row.name
+                ),
+            );
             ok = false;
         }
     }
-    for (k, row) in rows.into_iter().enumerate() {
-        let Some(row) = row else {
+    for c in rows {
+        let Some(ContactRow {
+            row, restitution, ..
+        }) = c
+        else {
             ok = false;
             continue;
         };
@@ -136,7 +169,7 @@ pub fn derive(
         out.list.push(Contact {
             name: row.name,
             docs: row.docs,
-            restitution: model.contacts[k].0,
+            restitution,
             gap,
             rate,
             gamma,

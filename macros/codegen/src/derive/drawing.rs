@@ -72,7 +72,8 @@ pub enum Attachment {
         frame: u32,
         point: Vec<ExprId>,
     },
-    /// A guide fixed in the ground: a line (plane) through `point` normal to `normal`.
+    /// A guide fixed in the ground, or the plane of a `PointPlane` contact fixed in the
+    /// ground: a line (plane) through `point` normal to `normal`.
     Guide {
         name: String,
         point: Vec<ExprId>,
@@ -240,7 +241,12 @@ pub fn build(
             } => (name, contact, up),
             _ => continue,
         };
-        if matches!(a, Attachment::Wheel { .. }) && grounds.iter().any(|(_, n)| n == normal) {
+        // One ground per rolling plane, and per distinct guide or contact plane.
+        let wheel = matches!(a, Attachment::Wheel { .. });
+        if grounds
+            .iter()
+            .any(|(p, n)| n == normal && (wheel || p == point))
+        {
             continue;
         }
         grounds.push((point.clone(), normal.clone()));

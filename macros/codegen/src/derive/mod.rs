@@ -210,7 +210,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         .iter()
         .map(|f| user_row(&mut tr, f, Context::Nonholonomic))
         .collect();
-    let contact_rows = contacts::translate(&mut tr, model);
+    let mut contact_rows = contacts::translate(&mut tr, model);
     drop(tr);
     let mut body_level = body_level;
     let (mut kinetic, mut potential) = (kinetic, potential);
@@ -226,6 +226,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 *r += nh0;
             }
         }
+        contact_rows.extend(bl.contacts.drain(..).map(Some));
         holonomic.extend(bl.holonomic.drain(..).map(Some));
         nonholonomic.extend(bl.nonholonomic.drain(..).map(Some));
         kinetic = kinetic.map(|k| g.add(vec![k, bl.kinetic]));

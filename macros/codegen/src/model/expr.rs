@@ -142,6 +142,20 @@ impl<'a> Translator<'a> {
         self.model.nq()
     }
 
+    /// The index of the parameter called `name`.
+    pub fn param_index(&self, name: &str) -> Option<u32> {
+        self.model.param_index(name)
+    }
+
+    /// The names of the parameters.
+    pub fn param_names(&self) -> Vec<String> {
+        self.model
+            .params
+            .iter()
+            .map(|p| p.name.to_string())
+            .collect()
+    }
+
     /// Translates a value in context `ctx` with no local bindings (a declaration's field).
     pub fn field_value(&mut self, e: &syn::Expr, ctx: Context) -> Option<Value> {
         self.with_locals(ctx, &[], |t| t.value(e))

@@ -18,6 +18,7 @@ pub const BODY: &str = "Body";
 pub const JOINT: &str = "Joint";
 pub const FORCE_ELEMENT: &str = "Force";
 pub const DRAWING: &str = "Drawing";
+pub const CONTACT_ITEM: &str = "Contact";
 /// The type of a run-time data slot (`static name: Data = ..;`).
 pub const DATA: &str = "Data";
 pub const Q0: &str = "q0";

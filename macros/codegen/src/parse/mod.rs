@@ -51,7 +51,7 @@ pub enum Item {
         docs: String,
         expr: syn::Expr,
     },
-    /// `static name: Frame|Point|Body|Joint|Force|Drawing = <constructor>;`, a declaration of
+    /// `static name: Frame|Point|Body|Joint|Force|Drawing|Contact = <constructor>;`, a declaration of
     /// the body level.
     Decl(Decl),
 }
@@ -66,6 +66,9 @@ pub enum DeclKind {
     Force,
     /// A shape to draw (`pfaff::Drawing`).
     Drawing,
+    /// A contact between a point and a surface (`PointPlane`, `PointSphere`), compiled to
+    /// a gap function like `#[contact(e)] fn`.
+    Contact,
 }
 
 /// A body-level declaration: its kind, name and constructor expression.
@@ -205,6 +208,7 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 (kw::JOINT, DeclKind::Joint),
                 (kw::FORCE_ELEMENT, DeclKind::Force),
                 (kw::DRAWING, DeclKind::Drawing),
+                (kw::CONTACT_ITEM, DeclKind::Contact),
             ]
             .into_iter()
             .find(|(n, _)| is_type(&s.ty, n))
@@ -228,7 +232,8 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
                 cx.error_spanned_by(
                     &s.ty,
                     "a `static` declares a generalized coordinate (`Coordinate`), a `Frame`, \
-                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing` or run-time `Data`",
+                     a `Point`, a `Body`, a `Joint`, a `Force`, a `Drawing`, a `Contact` or \
+                     run-time `Data`",
                 );
                 return None;
             }
