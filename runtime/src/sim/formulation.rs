@@ -70,6 +70,17 @@ pub(crate) trait Form {
         t: f64,
     ) -> Result<(), SimErrorKind>;
 
+    /// Fills `p` from `y` at `t` for a state the driver keeps (accepted or output),
+    /// before [`keep`](Self::keep) corrects it.
+    fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        self.reconstruct(p, t, y)
+    }
+
     /// Corrects a state the driver keeps (accepted or output), already reconstructed.
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
@@ -98,8 +109,14 @@ fn copy_state<M: Mechanism + ?Sized>(p: &mut Point<'_, M>, y: &[f64]) {
 #[derive(Debug)]
 pub(crate) struct Partitioned {
     chart: Chart,
-    /// The last accepted positions.
+    /// The last accepted positions, their time and the largest accepted speed
+    /// $\|\dot q\|_\infty$: in a rheonomic model the manifold moves with time, so an
+    /// evaluation at the accepted positions but a later time needs a correction of
+    /// about $|t - t_a|\,\|\dot q_a\|_\infty$ (Radau5's first stage guesses are the
+    /// accepted state itself), which is no branch switch.
     accepted: Vec<f64>,
+    t_accepted: f64,
+    speed_accepted: f64,
     /// Pivot ratio of the chart's $N N^\mathsf{T}$ when its rows were last chosen (0
     /// before the first anchor): the reference of [`REFIT_FRACTION`].
     fit_ratio: f64,
@@ -115,6 +132,8 @@ impl Partitioned {
         Self {
             chart: Chart::new(n, m, mh, rtol, atol),
             accepted: vec![0.0; n],
+            t_accepted: 0.0,
+            speed_accepted: 0.0,
             fit_ratio: 0.0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
@@ -132,6 +151,8 @@ impl Form for Partitioned {
         t: f64,
     ) -> Result<(), SimErrorKind> {
         self.accepted.copy_from_slice(&p.q);
+        self.t_accepted = t;
+        self.speed_accepted = inf_norm(&p.qd);
         if p.rows_h == 0 {
             return Ok(());
         }
@@ -196,7 +217,8 @@ impl Form for Partitioned {
             }
             let scale = inf_norm(&p.q);
             let floor = BRANCH_FLOOR * scale + self.chart.tolerance(scale);
-            if correction > moved + floor {
+            let drift = 2.0 * (t - self.t_accepted).abs() * self.speed_accepted;
+            if correction > moved + drift + floor {
                 return Err(SimErrorKind::NewtonFailed {
                     t,
                     iterations: 0,
@@ -222,6 +244,27 @@ impl Form for Partitioned {
     /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
     /// Newton, then the velocities): below the integrator's tolerance, so the
     /// derivatives the integrator keeps stay valid.
+    /// A kept state the chart's chord iteration cannot correct (an output point far
+    /// inside a long step of Radau5's dense output, where the anchor's normals no
+    /// longer contract) is left to [`keep`](Form::keep)'s full Newton projection from
+    /// `y` itself: an evaluation would be retried with a shorter step, a kept point
+    /// cannot.
+    fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        match self.reconstruct(p, t, y) {
+            Err(SimErrorKind::NewtonFailed { .. }) => {
+                self.cached = None;
+                copy_state(p, y);
+                Ok(())
+            }
+            r => r,
+        }
+    }
+
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -459,6 +502,15 @@ impl AnyForm {
         y: &[f64],
     ) -> Result<(), SimErrorKind> {
         each!(self, f => f.reconstruct(p, t, y))
+    }
+
+    pub fn reconstruct_kept<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), SimErrorKind> {
+        each!(self, f => f.reconstruct_kept(p, t, y))
     }
 
     pub fn accelerations<M: Mechanism + ?Sized>(

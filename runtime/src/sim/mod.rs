@@ -207,8 +207,8 @@ pub enum Method {
 }
 
 impl Method {
-    /// The adaptive explicit methods.
-    pub const ADAPTIVE: [Self; 3] = [Self::Dopri5, Self::Dop853, Self::Adams];
+    /// The methods with error control (the explicit pairs, Adams and Radau IIA).
+    pub const ADAPTIVE: [Self; 4] = [Self::Dopri5, Self::Dop853, Self::Adams, Self::Radau5];
 
     /// A short name.
     #[must_use]

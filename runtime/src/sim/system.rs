@@ -94,7 +94,7 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
     /// Fills the full state from `y` at `t` and corrects it as a kept state (accepted
     /// or output); returns what the integrator must do with the correction.
     pub fn keep(&mut self, t: f64, y: &[f64]) -> Result<Correction, SimErrorKind> {
-        self.form.reconstruct(&mut self.point, t, y)?;
+        self.form.reconstruct_kept(&mut self.point, t, y)?;
         self.form.keep(&mut self.point, t)?;
         Ok(self.form.correction())
     }

@@ -1,5 +1,6 @@
 //! Tolerance proportionality: on `pendulum`, `slider_crank`, `andrews` and `car_axis`,
-//! every formulation × integrator at rtol = 1e-3 … 1e-12 (atol = rtol/100, RK4 with the
+//! every formulation × integrator (RK4, DOPRI5, DOP853, Adams, Radau5) at rtol = 1e-3 …
+//! 1e-12 (atol = rtol/100, RK4 with the
 //! step `t_end·rtol^¼/10` of the work-precision sweep).
 //!
 //! **Error.** The largest error over the run (rows every 1/100 of the span), positions
@@ -103,6 +104,7 @@ fn sweep(
             Method::Dopri5,
             Method::Dop853,
             Method::Adams,
+            Method::Radau5,
         ] {
             let fixed = matches!(method, Method::Rk4 { .. });
             let mut line = format!("{name} {:<12} {:<6}", form.name(), method.name());
