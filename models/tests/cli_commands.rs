@@ -154,7 +154,8 @@ fn simulate_json_is_one_object_with_the_documented_keys() {
         .map(String::as_str)
         .collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["lambda", "outputs", "q", "qd", "qdd", "t"]);
+    assert_eq!(keys, ["joints", "lambda", "outputs", "q", "qd", "qdd", "t"]);
+    assert!(fin["joints"].is_null(), "pendulum has no joints");
     let (x, y) = (
         fin["q"]["x"].as_f64().unwrap(),
         fin["q"]["y"].as_f64().unwrap(),
@@ -496,4 +497,44 @@ fn progress_bar_stays_hidden_when_stderr_is_not_a_terminal() {
         "run too short to test the bar"
     );
     assert_eq!(stderr(&out), "");
+}
+
+/// `--json` reports each joint's wrench at the last state; on `slider_crank_bodies` the
+/// slider's free-body diagram closes: it moves along x only, so the vertical forces on
+/// it (the guide's, the coupler's through `pin_b`, gravity) sum to zero, and the
+/// horizontal ones to m3·ẍ3 (Newton's second law; ẍ3 from the report's `qdd`).
+#[test]
+fn json_reports_joint_reactions_that_balance_on_the_slider() {
+    let out = pfaff(&[
+        "simulate",
+        "slider_crank_bodies",
+        "--t-end",
+        "0.37",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let fin = &v["final"];
+    let joints = &fin["joints"];
+    let force = |j: &str, k: usize| joints[j]["first"]["force"][k].as_f64().unwrap();
+    // The guide's first frame is the slider; pin_b acts on its second frame (the
+    // slider) with the opposite of its force on the coupler.
+    let (m3, g) = (0.5, 9.81);
+    let xdd3 = fin["qdd"]["x3"].as_f64().unwrap();
+    let fy = force("guide", 1) - force("pin_b", 1) - m3 * g;
+    let fx = force("guide", 0) - force("pin_b", 0);
+    assert!(fy.abs() < 1e-9, "vertical balance {fy:e}");
+    assert!((fx - m3 * xdd3).abs() < 1e-9, "{fx} against {}", m3 * xdd3);
+    for (name, j) in joints.as_object().unwrap() {
+        assert!(j["residual"].as_f64().unwrap() < 1e-9, "{name}: {j}");
+    }
+    assert!(joints["driver"]["first"].is_null());
+    // The text summary lists them too.
+    let text = stdout(&pfaff(&[
+        "simulate",
+        "slider_crank_bodies",
+        "--t-end",
+        "0.37",
+    ]));
+    assert!(text.contains("joints") && text.contains("pin_b"), "{text}");
 }

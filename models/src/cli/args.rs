@@ -136,7 +136,7 @@ pub struct StateArgs {
 pub struct SimulateArgs {
     /// The model (see `pfaff list`).
     pub model: String,
-    /// End time [s]; the start is 0 (default: a span chosen per model, see `pfaff list`).
+    /// End time in seconds; the start is 0 (default: a span chosen per model, see `pfaff list`).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub t_end: Option<f64>,
     /// How the constraints are handled.
@@ -211,7 +211,7 @@ pub struct LinearizeArgs {
 pub struct WorkPrecisionArgs {
     /// The model (see `pfaff list`).
     pub model: String,
-    /// End time [s] (default: the model's span).
+    /// End time in seconds (default: the model's span).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub t_end: Option<f64>,
     /// Write the table as CSV.

@@ -61,3 +61,20 @@ pub fn accelerations(
         .map_err(|e| e.to_string())?;
     Ok(qdd)
 }
+
+/// The reaction of every joint of a body-level model at `(t, q)` with the multipliers
+/// `lambda` of that state (`None` for models without joints).
+pub fn joint_reactions(
+    model: &dyn Mechanism,
+    t: f64,
+    q: &[f64],
+    lambda: &[f64],
+) -> Option<pfaff::JointReactions> {
+    let info = model.info();
+    if info.joints.is_empty() {
+        return None;
+    }
+    let mut r = pfaff::JointReactions::new(info);
+    r.evaluate(model, t, q, lambda);
+    Some(r)
+}

@@ -38,7 +38,7 @@ pub struct Steady {
 /// Program-level knowledge of one model.
 #[derive(Clone, Copy, Debug)]
 pub struct Scene {
-    /// Default end time of `simulate` [s].
+    /// Default end time of `simulate`, in seconds.
     pub t_end: f64,
     /// Why that span.
     pub span: &'static str,

@@ -237,6 +237,35 @@ fn energies(model: &dyn Mechanism, run: &Run) -> Option<(f64, f64)> {
     }
 }
 
+/// The reactions of the joints as JSON: per joint its kind, the wrench on its first
+/// frame (force and torque about the frame's origin, global and body axes; `null` for a
+/// driver, which has no frames), the fit's relative residual and the number of wrench
+/// components the multipliers determine.
+fn joints_json(r: &pfaff::JointReactions) -> Value {
+    Value::Object(
+        r.iter()
+            .map(|j| {
+                let wrench = j.first.map_or(Value::Null, |w| {
+                    json!({
+                        "force": w.force,
+                        "torque": w.torque,
+                        "force_body": w.force_body,
+                        "torque_body": w.torque_body,
+                    })
+                });
+                let v = json!({
+                    "kind": format!("{:?}", j.kind),
+                    "first": wrench,
+                    "residual": j.residual,
+                    "rank": j.rank,
+                    "components": j.components,
+                });
+                (j.name.to_owned(), v)
+            })
+            .collect::<Map<_, _>>(),
+    )
+}
+
 /// The JSON report (see the README for its keys).
 pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> Value {
     let info = model.info();
@@ -254,12 +283,15 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         let qdd = outputs::accelerations(model, t, q, qd).map_or(Value::Null, |a| {
             named(info.coordinates.iter().map(|s| s.name), &a)
         });
+        let joints = outputs::joint_reactions(model, t, q, tr.lambda(i))
+            .map_or(Value::Null, |r| joints_json(&r));
         json!({
             "t": t,
             "q": named(info.coordinates.iter().map(|s| s.name), q),
             "qd": named(info.coordinates.iter().map(|s| s.name), qd),
             "qdd": qdd,
             "lambda": named(constraints, tr.lambda(i)),
+            "joints": joints,
             "outputs": named(output_names(), &outputs::values(model, t, q, qd)),
         })
     });
@@ -424,6 +456,39 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
                 w,
                 "stopped at   the start: no consistent state was computed"
             );
+        }
+    }
+    if let Some(i) = run.trajectory.len().checked_sub(1) {
+        let tr = &run.trajectory;
+        if let Some(r) = outputs::joint_reactions(model, tr.t[i], tr.q(i), tr.lambda(i)) {
+            let _ = writeln!(
+                w,
+                "joints       force [N] and torque [N m] on the first frame, about its origin, global axes, at the last state"
+            );
+            for j in r.iter() {
+                match j.first {
+                    Some(f) => {
+                        let _ = writeln!(
+                            w,
+                            "  {:<12} F = ({:.6e}, {:.6e}, {:.6e})  T = ({:.6e}, {:.6e}, {:.6e})",
+                            j.name,
+                            f.force[0],
+                            f.force[1],
+                            f.force[2],
+                            f.torque[0],
+                            f.torque[1],
+                            f.torque[2]
+                        );
+                    }
+                    None => {
+                        let _ = writeln!(
+                            w,
+                            "  {:<12} no frames (a driver): see lambda in --json",
+                            j.name
+                        );
+                    }
+                }
+            }
         }
     }
     if let (Some((t, q, qd)), true) = (run.final_state(), req.t_end == 0.0) {

@@ -426,6 +426,74 @@ fn locate_in<M: Mechanism + ?Sized>(
     Ok(Some(Found::Release { c: k, t: b }))
 }
 
+/// Moves the closing of contact `k` located at `te` on the dense output of the step
+/// `[t0, t1]` (which started at `y0`) to where the integrator's own steps put it: the
+/// stepper is restarted at `(t0, y0)` and steps to `te`, and `te` moves by the Newton
+/// correction `−δ/δ̇` of the gap found there (the rate from the dense output), at most
+/// three times. For an integrator whose dense output is less accurate than its steps
+/// (RADAU5's collocation polynomial has the stage order 3), this brings the event
+/// time to the accuracy of the steps. The stepper ends at the returned time.
+pub(crate) fn refine<M: Mechanism + ?Sized>(
+    stepper: &mut Stepper,
+    sys: &mut System<'_, M>,
+    span: (f64, f64),
+    y0: &[f64],
+    k: usize,
+    te: f64,
+    y: &mut [f64],
+) -> Result<f64, Refined> {
+    let (t0, t1) = span;
+    let mech = sys.point.mech;
+    let n = mech.info().nq();
+    let gap = |sys: &mut System<'_, M>, t: f64, q: &[f64]| -> Result<f64, Refined> {
+        match sys.contacts.as_mut() {
+            Some(c) => c
+                .solver
+                .gaps(mech, t, q)
+                .map(|g| g[k])
+                .map_err(|e| Refined::Sim(SimErrorKind::from_eval(e))),
+            None => Ok(0.0),
+        }
+    };
+    let a = (te - 1e-3 * (t1 - t0)).max(t0);
+    stepper.interpolate(a, y).map_err(Refined::Ode)?;
+    let ga = gap(sys, a, &y[..n])?;
+    stepper.interpolate(te, y).map_err(Refined::Ode)?;
+    let gb = gap(sys, te, &y[..n])?;
+    let rate = (gb - ga) / (te - a);
+    if !(rate < 0.0 && rate.is_finite()) {
+        // Not a closing the dense output resolves: its time stays.
+        return Ok(te);
+    }
+    let mut te = te;
+    for iteration in 0..3 {
+        stepper
+            .reset(sys, t0, y0, Some(te - t0))
+            .map_err(Refined::Ode)?;
+        while stepper.t() < te {
+            stepper.step(sys, Some(te)).map_err(Refined::Ode)?;
+        }
+        y.copy_from_slice(stepper.y());
+        let g = gap(sys, te, &y[..n])?;
+        if g.abs() <= gap_tol(&y[..n]) || iteration == 2 {
+            break;
+        }
+        let next = te - g / rate;
+        if next.is_nan() || next <= t0 || (next - te).abs() <= 4.0 * f64::EPSILON * te.abs() {
+            break;
+        }
+        te = next;
+    }
+    Ok(te)
+}
+
+/// A failure while refining an event time: of the integrator, or of an evaluation.
+#[derive(Debug)]
+pub(crate) enum Refined {
+    Ode(crate::ode::OdeError),
+    Sim(SimErrorKind),
+}
+
 /// Handles an event (or, with `None`, the contacts closed at the start) at `t`, the
 /// point holding the kept state there: the impacts of the sequential law, then the
 /// contacts that come to rest or release. Returns the first step to restart with

@@ -17,6 +17,7 @@
 
 use std::time::Instant;
 
+use super::contacts::{Found, Refined};
 use super::error::{SimError, SimErrorKind};
 use super::formulation::Correction;
 use super::stepper::Stepper;
@@ -365,6 +366,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
 
     let mut yout = vec![0.0; dim];
+    // RADAU5's dense output (the collocation polynomial, of the stage order 3) is less
+    // accurate than its steps: a closing located on it is moved to where the steps put
+    // it (`contacts::refine`), which needs the state at the start of the step.
+    let refine_events = matches!(sim.method, super::Method::Radau5) && rec.sys.contacts.is_some();
+    let mut y_start = vec![0.0; if refine_events { dim } else { 0 }];
     let mut next_out = 0;
     let steps_mode = matches!(sim.output, Output::Steps);
 
@@ -392,6 +398,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             });
         }
         let t_prev = stepper.t();
+        if refine_events {
+            y_start.copy_from_slice(stepper.y());
+        }
         let partitions = rec.sys.point.kin.repartitions();
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
@@ -402,7 +411,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         };
         // Contacts: the first event in the step truncates it there (rows before it from
         // this step's dense output), the jump is applied and the integrator restarts.
-        if let Some(found) = check!(super::contacts::locate(&mut rec.sys, &stepper, t_prev)) {
+        if let Some(mut found) = check!(super::contacts::locate(&mut rec.sys, &stepper, t_prev)) {
             let te = found.t();
             while next_out < times.len() && times[next_out] < te {
                 let to = times[next_out];
@@ -411,6 +420,34 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 check!(rec.record(to));
                 next_out += 1;
             }
+            if let (true, Found::Closing { c: k, t: te }) = (refine_events, found) {
+                let refined = super::contacts::refine(
+                    &mut stepper,
+                    &mut rec.sys,
+                    (t_prev, t),
+                    &y_start,
+                    k,
+                    te,
+                    &mut yout,
+                );
+                match refined {
+                    Ok(te) => found = Found::Closing { c: k, t: te },
+                    Err(Refined::Ode(e)) => {
+                        let kind = failure(e, &mut rec.sys);
+                        bail!(kind)
+                    }
+                    Err(Refined::Sim(kind)) => bail!(kind),
+                }
+                // Rows the correction moved before the event.
+                while next_out < times.len() && times[next_out] < found.t() {
+                    let to = times[next_out];
+                    check!(stepper.interpolate(to, &mut yout).map_err(ode));
+                    check!(rec.sys.keep(to, &yout));
+                    check!(rec.record(to));
+                    next_out += 1;
+                }
+            }
+            let te = found.t();
             check!(stepper.interpolate(te, &mut yout).map_err(ode));
             check!(rec.sys.keep(te, &yout));
             let before = rec

@@ -277,6 +277,11 @@ pub fn lower(
 }
 
 fn integer(cx: &Ctxt, e: &syn::Expr, what: &str) -> Option<usize> {
+    // A literal passed through a `macro_rules!` fragment arrives in an invisible group.
+    let mut e = e;
+    while let syn::Expr::Group(g) = e {
+        e = &g.expr;
+    }
     if let syn::Expr::Lit(syn::ExprLit {
         lit: syn::Lit::Int(i),
         ..
