@@ -254,11 +254,7 @@ static ALL: &[Entry] = &[
         summary: "the flexible slider crank with the rod's invariants integrated from its shape functions",
         make: || Box::new(flexible_crank_shapes::Model::default()),
     },
-    Entry {
-        name: "spinup_beam",
-        summary: "spin-up of a cantilever beam (Kane, Ryan & Banerjee 1987), with or without geometric stiffening; use radau5",
-        make: || Box::new(spinup_beam::Model::default()),
-    },
+
     Entry {
         name: "chain10",
         summary: "spatial chain of 10 rods on ball joints, Euler parameters (scaling, n = 70)",

@@ -103,13 +103,6 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
-            "spinup_beam" => Self {
-                t_end: 20.0,
-                span: "the spin-up and 5 s at constant speed",
-                steady: None,
-                closed_form: None,
-                impact_times: None,
-            },
             "flexible_crank" | "flexible_crank_shapes" => Self {
                 t_end: 0.1,
                 span: "the test set's span",
