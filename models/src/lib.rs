@@ -26,6 +26,8 @@
 //! | [`body_impact`] | `x y phi` | 1 contact (math-spec V13) |
 //! | [`two_body_impact`] | `x1 y1 phi1 x2 y2 phi2` | 1 contact (math-spec V14) |
 //! | [`newtons_cradle`] | `theta1 theta2 theta3` | 2 contacts |
+//! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
+//! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -61,6 +63,8 @@ mod falling_rod_model;
 mod chain_models {
     include!(concat!(env!("OUT_DIR"), "/chain10.rs"));
 }
+#[path = "flexible_crank.rs"]
+mod flexible_crank_model;
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -98,6 +102,7 @@ pub use bricard_model::bricard;
 pub use car_axis_model::car_axis;
 pub use chain_models::chain10;
 pub use falling_rod_model::falling_rod;
+pub use flexible_crank_model::{flexible_crank, flexible_crank_shapes};
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
@@ -234,6 +239,16 @@ static ALL: &[Entry] = &[
         name: "newtons_cradle",
         summary: "Newton's cradle, three balls on strings (sequential impacts)",
         make: || Box::new(newtons_cradle::Model::default()),
+    },
+    Entry {
+        name: "flexible_crank",
+        summary: "slider crank with an elastic rod in the floating frame (Simeon's test-set invariants); stiff: use radau5",
+        make: || Box::new(flexible_crank::Model::default()),
+    },
+    Entry {
+        name: "flexible_crank_shapes",
+        summary: "the flexible slider crank with the rod's invariants integrated from its shape functions",
+        make: || Box::new(flexible_crank_shapes::Model::default()),
     },
     Entry {
         name: "chain10",

@@ -11,6 +11,8 @@ mod bodies;
 #[cfg(test)]
 mod cli;
 #[cfg(test)]
+mod flex;
+#[cfg(test)]
 mod free_motion;
 #[cfg(test)]
 mod fuzz;

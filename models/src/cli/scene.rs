@@ -103,6 +103,13 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
+            "flexible_crank" | "flexible_crank_shapes" => Self {
+                t_end: 0.1,
+                span: "the test set's span",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
             "andrews" => Self {
                 t_end: 0.03,
                 span: "the reference span of Hairer & Wanner",

@@ -180,6 +180,10 @@ impl Chart {
                 step = step.max(dq.abs());
                 weighted = weighted.max(dq.abs() / (self.atol + self.rtol * qj.abs()));
             }
+            // An update at round-off has converged, whatever rate its noise suggests.
+            if step <= floor {
+                return Ok(iteration + 1);
+            }
             if let Some(p) = previous {
                 let measured = weighted / p;
                 if measured.is_nan() || measured >= DIVERGENCE {

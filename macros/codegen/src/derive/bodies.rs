@@ -15,6 +15,9 @@
 
 use std::collections::HashMap;
 
+#[path = "deformable.rs"]
+mod deformable;
+
 use proc_macro2::Span;
 use quote::ToTokens;
 use syn::spanned::Spanned;
@@ -199,13 +202,39 @@ fn fields<'a>(
 const FRAME_KINDS: &[(&str, &[&str], &[&str])] =
     &[("Frame", &["origin"], &["parent", "angle", "rotation"])];
 const POINT_KINDS: &[(&str, &[&str], &[&str])] = &[("Point", &["frame"], &["at"])];
-const BODY_KINDS: &[(&str, &[&str], &[&str])] = &[(
-    "Body",
-    &["mass"],
-    &[
-        "frame", "parent", "origin", "angle", "rotation", "inertia", "com",
-    ],
-)];
+const BODY_KINDS: &[(&str, &[&str], &[&str])] = &[
+    (
+        "Body",
+        &["mass"],
+        &[
+            "frame", "parent", "origin", "angle", "rotation", "inertia", "com",
+        ],
+    ),
+    (
+        "Deformable",
+        &["elastic"],
+        &[
+            "data",
+            "parent",
+            "origin",
+            "angle",
+            "rotation",
+            "mass",
+            "com",
+            "inertia",
+            "span",
+            "position",
+            "displacement",
+            "density",
+            "invariants",
+            "stiffness",
+            "axial_rigidity",
+            "bending_rigidity",
+            "stiffening",
+            "damping",
+        ],
+    ),
+];
 const JOINT_KINDS: &[(&str, &[&str], &[&str])] = &[
     (
         "Revolute",
@@ -607,6 +636,9 @@ impl<'a> Builder<'_, 'a> {
 
     fn body(&mut self, d: &Decl) -> Option<()> {
         let fl = fields(self.cx, &d.expr, BODY_KINDS, "body")?;
+        if fl.kind == "Deformable" {
+            return self.deformable(d, &fl);
+        }
         let k = if let Some(f) = fl.get("frame") {
             for other in ["parent", "origin", "angle", "rotation"] {
                 if let Some(e) = fl.get(other) {

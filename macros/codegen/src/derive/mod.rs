@@ -22,6 +22,7 @@ pub mod contacts;
 pub mod data;
 pub mod drawing;
 pub mod free_motion;
+pub mod integrate;
 pub mod linear;
 
 use crate::ctxt::Ctxt;

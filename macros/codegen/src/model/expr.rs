@@ -92,6 +92,9 @@ pub struct Translator<'a> {
     pub point_names: Vec<String>,
     /// Global positions of the points translated so far.
     pub points: Vec<Vec<ExprId>>,
+    /// The material description of deformable bodies, by frame index (for
+    /// `body.material(ξ)`).
+    pub materials: Vec<(usize, super::value::Material)>,
 }
 
 const METHODS: &[&str] = &[
@@ -115,6 +118,7 @@ impl<'a> Translator<'a> {
             frames: Vec::new(),
             point_names: model.point_names(),
             points: Vec::new(),
+            materials: Vec::new(),
         }
     }
 
@@ -138,6 +142,11 @@ impl<'a> Translator<'a> {
     }
 
     /// The number of coordinates.
+    /// The model being translated.
+    pub fn model(&self) -> &'a Model {
+        self.model
+    }
+
     pub fn nq(&self) -> usize {
         self.model.nq()
     }
@@ -230,6 +239,29 @@ impl<'a> Translator<'a> {
                 None
             }
         }
+    }
+
+    /// Translates `e` with the extra local `name = value` on top of the current
+    /// bindings and context (a closure's argument).
+    pub fn with_binding<T>(
+        &mut self,
+        name: &str,
+        value: Value,
+        body: impl FnOnce(&mut Self) -> Option<T>,
+    ) -> Option<T> {
+        self.locals.push((name.to_owned(), value));
+        let out = body(self);
+        self.locals.pop();
+        out
+    }
+
+    /// Runs `body` in context `ctx` with no local bindings.
+    pub fn in_context<T>(
+        &mut self,
+        ctx: Context,
+        body: impl FnOnce(&mut Self) -> Option<T>,
+    ) -> Option<T> {
+        self.with_locals(ctx, &[], body)
     }
 
     fn with_locals<T>(

@@ -11,7 +11,8 @@
 //! derivative along the motion), rotations `rot2(θ)`, `rot_x(θ)`, `rot_y(θ)`, `rot_z(θ)`,
 //! `euler_parameters(e0, e1, e2, e3)`, `diag(a, b, c)`, and on a frame `f`:
 //! `f.origin()`, `f.rotation()`, `f.point([..])`, `f.axis([..])`, `f.velocity([..])`,
-//! `f.angular_velocity()` and, for planar frames, `f.angle()`.
+//! `f.angular_velocity()`, for planar frames `f.angle()`, and for deformable bodies
+//! `f.material(ξ)` (the deformed position of material point `ξ` in the body's frame).
 
 use quote::ToTokens;
 
@@ -54,6 +55,48 @@ pub struct FrameValue {
     pub angle: Option<ExprId>,
     /// Frames oriented by Euler parameters: the four parameters.
     pub euler: Option<[ExprId; 4]>,
+}
+
+/// A closure of the description, `|xi| body`: a function of one material coordinate.
+#[derive(Clone, Debug)]
+pub struct Closure {
+    /// The argument's name.
+    pub var: String,
+    pub body: syn::Expr,
+}
+
+/// The material description of a deformable body: the undeformed position `ū_o(ξ)` and
+/// the displacement `N(ξ) q_f` of the material point `ξ`, in the body's frame.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub dim: usize,
+    pub position: Option<Closure>,
+    pub displacement: Option<Closure>,
+}
+
+impl Material {
+    /// `ū_o(ξ) + N(ξ) q_f` at `xi`, in the body's frame (the current translation context).
+    pub fn at(
+        &self,
+        tr: &mut Translator<'_>,
+        at: &dyn ToTokens,
+        xi: ExprId,
+    ) -> Option<Vec<ExprId>> {
+        let Some(p) = &self.position else {
+            tr.cx.error_spanned_by(
+                at,
+                "this deformable body declares no `position: |xi| [..]`, so its material points are unknown",
+            );
+            return None;
+        };
+        let dim = self.dim;
+        let u = tr.with_binding(&p.var, Value::Scalar(xi), |t| t.vector(&p.body, Some(dim)))?;
+        let Some(d) = &self.displacement else {
+            return Some(u);
+        };
+        let w = tr.with_binding(&d.var, Value::Scalar(xi), |t| t.vector(&d.body, Some(dim)))?;
+        Some(add_v(tr.g, &u, &w))
+    }
 }
 
 // ---- component algebra on the graph ----
@@ -284,6 +327,7 @@ const FRAME_METHODS: &[&str] = &[
     "velocity",
     "angular_velocity",
     "angle",
+    "material",
 ];
 const MATRIX_FUNCTIONS: &[&str] = &[
     "rot2",
@@ -784,7 +828,7 @@ impl Translator<'_> {
     ) -> Option<Value> {
         let dim = f.map_or_else(|| self.model_dim(), |k| self.frames[k].dim);
         let fv = self.frame_value(f, dim);
-        let want = usize::from(matches!(name, "point" | "axis" | "velocity"));
+        let want = usize::from(matches!(name, "point" | "axis" | "velocity" | "material"));
         if m.args.len() != want {
             self.cx.error_spanned_by(
                 m,
@@ -831,6 +875,23 @@ impl Translator<'_> {
                 Value::Vector(p.iter().map(|&x| time_derivative(self.g, nq, x)).collect())
             }
             "angular_velocity" => fv.angular_velocity(self.g, nq),
+            "material" => {
+                let material = f.and_then(|k| {
+                    self.materials
+                        .iter()
+                        .find(|(i, _)| *i == k)
+                        .map(|(_, m)| m.clone())
+                });
+                let Some(material) = material else {
+                    self.cx.error_spanned_by(
+                        &m.method,
+                        "`material` applies to deformable bodies (`Deformable { .. }`)",
+                    );
+                    return None;
+                };
+                let xi = self.expr(&m.args[0])?;
+                Value::Vector(material.at(self, &m.args[0], xi)?)
+            }
             _ => unreachable!("frame methods are listed"),
         })
     }
