@@ -214,6 +214,7 @@ const BODY_KINDS: &[(&str, &[&str], &[&str])] = &[
         "Deformable",
         &["elastic"],
         &[
+            "data",
             "parent",
             "origin",
             "angle",

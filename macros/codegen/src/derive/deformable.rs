@@ -486,6 +486,35 @@ impl Builder<'_, '_> {
         dim: usize,
         nf: usize,
     ) -> Option<Invariants> {
+        if let Some(e) = fl.get("data") {
+            // A beam-element body or exported invariants, read at run time.
+            for other in [
+                "mass",
+                "com",
+                "inertia",
+                "invariants",
+                "density",
+                "position",
+            ] {
+                if let Some(x) = fl.get(other) {
+                    self.cx.error_spanned_by(
+                        x,
+                        format!("`{other}` is part of the invariants, which `data` already gives"),
+                    );
+                    return None;
+                }
+            }
+            let model = self.tr.model();
+            let l = crate::derive::data::slot_leaves(self.cx, model, self.tr.g, e, dim, nf)?;
+            return Some(Invariants {
+                m: l.m,
+                i1: l.i1,
+                i_kl: l.i_kl,
+                s_bar: l.s_bar,
+                i_bar: l.i_bar,
+                s_kl: l.s_kl,
+            });
+        }
         let span = fl.span;
         // Where an integral that fails points: the closure that brought the bad term.
         let field_span = |name: &str| At(fl.get(name), span);
@@ -756,6 +785,25 @@ impl Builder<'_, '_> {
         nf: usize,
         qv: &[ExprId],
     ) -> Option<Option<Vec<ExprId>>> {
+        if let Some(e) = fl.get("data") {
+            for other in [
+                "stiffness",
+                "axial_rigidity",
+                "bending_rigidity",
+                "stiffening",
+            ] {
+                if let Some(x) = fl.get(other) {
+                    self.cx.error_spanned_by(
+                        x,
+                        format!("`{other}`: the stiffness comes with the body's `data`"),
+                    );
+                    return None;
+                }
+            }
+            let model = self.tr.model();
+            let l = crate::derive::data::slot_leaves(self.cx, model, self.tr.g, e, dim, nf)?;
+            return Some(Some(l.k_ff));
+        }
         if let Some(e) = fl.get("stiffness") {
             for other in ["axial_rigidity", "bending_rigidity", "stiffening"] {
                 if let Some(x) = fl.get(other) {

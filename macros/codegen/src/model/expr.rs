@@ -142,6 +142,11 @@ impl<'a> Translator<'a> {
     }
 
     /// The number of coordinates.
+    /// The model being translated.
+    pub fn model(&self) -> &'a Model {
+        self.model
+    }
+
     pub fn nq(&self) -> usize {
         self.model.nq()
     }
