@@ -27,6 +27,7 @@
 //! | [`two_body_impact`] | `x1 y1 phi1 x2 y2 phi2` | 1 contact (math-spec V14) |
 //! | [`newtons_cradle`] | `theta1 theta2 theta3` | 2 contacts |
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
+//! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
 //! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
 //!
 //! ```
@@ -93,6 +94,8 @@ mod slider_crank_bodies_model;
 mod slider_crank_model;
 #[path = "spatial_four_bar.rs"]
 mod spatial_four_bar_model;
+#[path = "spinup_beam.rs"]
+mod spinup_beam_model;
 
 pub use andrews_model::andrews;
 pub use bicycle_model::bicycle;
@@ -117,6 +120,7 @@ pub use sleigh_wall_model::sleigh_wall;
 pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
 pub use spatial_four_bar_model::spatial_four_bar;
+pub use spinup_beam_model::spinup_beam;
 
 /// A built-in model as listed by the command-line program.
 #[derive(Clone, Copy, Debug)]
@@ -250,6 +254,7 @@ static ALL: &[Entry] = &[
         summary: "the flexible slider crank with the rod's invariants integrated from its shape functions",
         make: || Box::new(flexible_crank_shapes::Model::default()),
     },
+
     Entry {
         name: "chain10",
         summary: "spatial chain of 10 rods on ball joints, Euler parameters (scaling, n = 70)",

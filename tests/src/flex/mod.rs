@@ -6,6 +6,7 @@
 mod crank;
 mod models;
 mod shapes;
+mod spinup;
 
 /// Largest absolute difference of two slices.
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
