@@ -245,10 +245,19 @@ pub(crate) fn locate<M: Mechanism + ?Sized>(
     stepper: &Stepper,
     t0: f64,
 ) -> Result<Option<Found>, SimErrorKind> {
+    with_contacts(sys, |c, sys| locate_in(c, sys, stepper, t0))
+}
+
+/// Runs `f` on the run's contacts, lent out of `sys` for the call (`None` without
+/// contacts).
+fn with_contacts<M: Mechanism + ?Sized, R>(
+    sys: &mut System<'_, M>,
+    f: impl FnOnce(&mut Contacts, &mut System<'_, M>) -> Result<Option<R>, SimErrorKind>,
+) -> Result<Option<R>, SimErrorKind> {
     let Some(mut c) = sys.contacts.take() else {
         return Ok(None);
     };
-    let r = locate_in(&mut c, sys, stepper, t0);
+    let r = f(&mut c, sys);
     sys.contacts = Some(c);
     r
 }
@@ -503,12 +512,7 @@ pub(crate) fn handle<M: Mechanism + ?Sized>(
     found: Option<Found>,
     t: f64,
 ) -> Result<Option<f64>, SimErrorKind> {
-    let Some(mut c) = sys.contacts.take() else {
-        return Ok(None);
-    };
-    let r = handle_in(&mut c, sys, found, t);
-    sys.contacts = Some(c);
-    r
+    with_contacts(sys, |c, sys| handle_in(c, sys, found, t))
 }
 
 #[allow(clippy::too_many_lines)]

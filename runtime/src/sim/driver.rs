@@ -366,10 +366,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
 
     let mut yout = vec![0.0; dim];
-    // RADAU5's dense output (the collocation polynomial, of the stage order 3) is less
-    // accurate than its steps: a closing located on it is moved to where the steps put
-    // it (`contacts::refine`), which needs the state at the start of the step.
-    let refine_events = matches!(sim.method, super::Method::Radau5) && rec.sys.contacts.is_some();
+    // A closing located on a dense output coarser than the steps is moved to where the
+    // steps put it (`contacts::refine`), which needs the state at the start of the step.
+    let refine_events = sim.method.coarse_dense_output() && rec.sys.contacts.is_some();
     let mut y_start = vec![0.0; if refine_events { dim } else { 0 }];
     let mut next_out = 0;
     let steps_mode = matches!(sim.output, Output::Steps);
@@ -586,11 +585,10 @@ fn failure<M: Mechanism + ?Sized>(e: OdeError, sys: &mut System<'_, M>) -> SimEr
 /// that size in $f$, and $10^8$ times it in the Jacobian. For it the chart iterates to
 /// round-off ([`NEWTON_TOLERANCE`](super::NEWTON_TOLERANCE), relative).
 fn chart_tolerances(method: Method, rtol: f64, atol: f64) -> (f64, f64) {
-    match method {
-        Method::Radau5 => {
-            let tight = super::NEWTON_TOLERANCE;
-            (tight, atol * tight / rtol.max(tight))
-        }
-        _ => (rtol, atol),
+    if method.differences_rhs() {
+        let tight = super::NEWTON_TOLERANCE;
+        (tight, atol * tight / rtol.max(tight))
+    } else {
+        (rtol, atol)
     }
 }

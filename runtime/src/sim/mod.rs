@@ -210,6 +210,21 @@ impl Method {
     /// The methods with error control (the explicit pairs, Adams and Radau IIA).
     pub const ADAPTIVE: [Self; 4] = [Self::Dopri5, Self::Dop853, Self::Adams, Self::Radau5];
 
+    /// Whether the method forms $\partial f/\partial y$ by differences of the
+    /// right-hand side (Radau5): the partitioning chart must then iterate to round-off,
+    /// not to the integrator's tolerance (`driver::chart_tolerances`).
+    pub(crate) const fn differences_rhs(self) -> bool {
+        matches!(self, Self::Radau5)
+    }
+
+    /// Whether the method's dense output is less accurate than its steps (Radau5's
+    /// collocation polynomial has the stage order 3, its steps order 5): a gap closing
+    /// located on it is moved to where the steps put it (`contacts::refine`). The
+    /// explicit pairs and Adams interpolate at their steps' accuracy.
+    pub(crate) const fn coarse_dense_output(self) -> bool {
+        matches!(self, Self::Radau5)
+    }
+
     /// A short name.
     #[must_use]
     pub fn name(&self) -> &'static str {
