@@ -110,6 +110,13 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
+            "spinup_beam" => Self {
+                t_end: 20.0,
+                span: "the benchmark's span: spin-up over 15 s, then 5 s at constant rate",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
             "andrews" => Self {
                 t_end: 0.03,
                 span: "the reference span of Hairer & Wanner",
