@@ -29,6 +29,7 @@
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
 //! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
 //! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
+//! | [`flexible_pendulum`] | `e0 e1 e2 e3 p1 p2 p3 p4` | 1 holonomic (Euler-parameter normalization); a bar of spatial beam elements |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -66,6 +67,8 @@ mod chain_models {
 }
 #[path = "flexible_crank.rs"]
 mod flexible_crank_model;
+#[path = "flexible_pendulum.rs"]
+mod flexible_pendulum_model;
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -106,6 +109,7 @@ pub use car_axis_model::car_axis;
 pub use chain_models::chain10;
 pub use falling_rod_model::falling_rod;
 pub use flexible_crank_model::{flexible_crank, flexible_crank_shapes};
+pub use flexible_pendulum_model::flexible_pendulum;
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
@@ -281,6 +285,12 @@ static ALL: &[Entry] = &[
         summary: "the flexible slider crank with the rod's invariants integrated from its shape functions",
         make: || Box::new(flexible_crank_shapes::Model::default()),
         stiff: true,
+    },
+    Entry {
+        name: "flexible_pendulum",
+        summary: "spatial flexible pendulum: a bar of 8 spatial beam elements, 4 modes, on a ball joint",
+        make: || Box::new(flexible_pendulum::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "spinup_beam",
