@@ -250,7 +250,6 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let t_lagrange = lagrange_kinetic?;
     let v_pot = potential?;
     let qv: Vec<ExprId> = (0..n).map(|i| g.var(Var::Qd(idx(i)))).collect();
-    let qd_pairs: Vec<(Var, ExprId)> = (0..n).map(|i| (Var::Q(idx(i)), qv[i])).collect();
 
     // Mass matrix and quadratic-velocity forces from T.
     let momenta: Vec<ExprId> = (0..n)
@@ -280,15 +279,13 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     for i in 0..n {
         let qi = Var::Q(idx(i));
         let dt_dq = diff::differentiate(g, t_lagrange, qi);
-        let conv = diff::directional(g, momenta[i], &qd_pairs);
-        let dp_dt = diff::differentiate(g, momenta[i], Var::Time);
+        let dp = diff::rate(g, momenta[i]);
         let dv_dq = diff::differentiate(g, v_pot, qi);
         let qe = applied[i]?;
-        let neg_conv = g.neg(conv);
-        let neg_dpdt = g.neg(dp_dt);
+        let neg_dp = g.neg(dp);
         let neg_dv = g.neg(dv_dq);
         let kane = body_level.as_ref().map_or(zero_q, |bl| bl.inertial[i]);
-        forces.push(g.add(vec![qe, dt_dq, neg_conv, neg_dpdt, neg_dv, kane]));
+        forces.push(g.add(vec![qe, dt_dq, neg_dp, neg_dv, kane]));
         applied_forces.push(qe);
     }
     let mut has_virtual_work = false;
@@ -328,9 +325,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         let h_t = diff::differentiate(g, h, Var::Time);
         rate_terms.push(h_t);
         let cdot = g.add(rate_terms);
-        let along = diff::directional(g, cdot, &qd_pairs);
-        let dt = diff::differentiate(g, cdot, Var::Time);
-        let s = g.add(vec![along, dt]);
+        let s = diff::rate(g, cdot);
         c.push(h);
         ct.push(h_t);
         gamma_h.push(g.neg(s));
@@ -371,9 +366,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             _ => None,
         });
         gb.push(bias);
-        let along = diff::directional(g, nh, &qd_pairs);
-        let dt = diff::differentiate(g, nh, Var::Time);
-        let s = g.add(vec![along, dt]);
+        let s = diff::rate(g, nh);
         gamma_nh.push(g.neg(s));
     }
     if checking && cx.has_errors() {
