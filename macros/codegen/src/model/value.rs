@@ -17,7 +17,7 @@
 use quote::ToTokens;
 
 use super::expr::Translator;
-use crate::sym::{diff, ExprId, Graph};
+use crate::sym::{diff, ExprId, Graph, Var};
 
 /// The value of an expression.
 #[derive(Clone, Debug, PartialEq)]
