@@ -377,11 +377,10 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     }
     fns.extend(dynamics_terms(g, &names, d));
     fns.extend(solve::augmented_solve(
+        g,
         model.coords.len(),
         (d.c.len(), d.gb.len()),
-        &d.mass,
-        &d.cq,
-        &d.gm,
+        (&d.mass, &d.cq, &d.gm),
     ));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();

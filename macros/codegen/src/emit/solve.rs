@@ -18,6 +18,16 @@
 //! mass matrix singular off the constraints — Euler parameters —, redundant or
 //! nearly dependent constraints, a singular configuration) makes the function return
 //! `Declined`, and the runtime solves with its general path, which decides rank.
+//!
+//! **Euler parameters.** The kinetic energy of a body oriented by Euler parameters
+//! $\theta$ does not depend on $\dot\theta$ along $\theta$: $M\theta = 0$, and only
+//! the normalization row $C_r = \theta^\mathsf{T}\theta - 1$ (gradient $2\theta$)
+//! makes $K$ regular. Such a row (every entry `k q_c` of its own column, the columns a
+//! block of $M$'s pattern, so no fill) is added to $M$ in the augmented-Lagrangian way,
+//! $\tilde M = M + \rho J_r^\mathsf{T} J_r$, $\tilde Q = Q + \rho J_r^\mathsf{T}
+//! \gamma_r$, which leaves the solution unchanged ($J_r\ddot q = \gamma_r$) and makes
+//! $\tilde M$ positive definite; $\rho = \sum_c M_{cc} / \sum_c J_{rc}^2$ gives the
+//! added block the trace of $M$'s, so it does not depend on the units.
 
 use std::collections::{BTreeSet, HashMap};
 
@@ -25,6 +35,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use crate::derive::Entry;
+use crate::sym::{ExprId, Graph, Node, Var};
 
 /// Largest operation count (multiplications and additions of the factorization and the
 /// solves) for which the specialized solve is emitted. Above it the straight-line code
@@ -54,8 +65,43 @@ pub struct Plan {
     /// Multiplications and additions of the factorization and the solves.
     pub operations: usize,
     n: usize,
-    /// Lower-triangle entries `(node, node)` of $K$ (both orders stored) and their source.
+    /// Entries `(node, node)` of $K$ (both orders stored) and their source.
     entries: HashMap<(usize, usize), Source>,
+    /// The rows added to $M$ (see the module docs): per row, the holonomic row and its
+    /// entries `(column, index in cq)`.
+    added: Vec<(usize, Vec<(usize, usize)>)>,
+}
+
+/// The holonomic rows $C_r = \tfrac k2 \sum_c q_c^2 + \dots$ whose columns form a block
+/// of $M$'s pattern: rows `k q_c` in every column (Euler parameters' normalization).
+pub fn normalization_rows(g: &Graph, mass: &[Entry], cq: &[Entry]) -> Vec<usize> {
+    let in_mass: std::collections::HashSet<(u32, u32)> =
+        mass.iter().map(|e| (e.row, e.col)).collect();
+    // `k q_c` → k.
+    let coefficient = |id: ExprId, c: u32| match g.node(id) {
+        Node::Mul(f) if f.len() == 2 => match (g.node(f[0]), g.node(f[1])) {
+            (Node::Const(k), Node::Var(Var::Q(v))) | (Node::Var(Var::Q(v)), Node::Const(k))
+                if *v == c =>
+            {
+                Some(*k)
+            }
+            _ => None,
+        },
+        _ => None,
+    };
+    let rows = cq.iter().map(|e| e.row as usize + 1).max().unwrap_or(0);
+    (0..rows)
+        .filter(|&r| {
+            let row: Vec<&Entry> = cq.iter().filter(|e| e.row as usize == r).collect();
+            let k = row.first().and_then(|e| coefficient(e.expr, e.col));
+            row.len() > 1
+                && k.is_some()
+                && row.iter().all(|e| coefficient(e.expr, e.col) == k)
+                && row
+                    .iter()
+                    .all(|a| row.iter().all(|b| in_mass.contains(&(a.col, b.col))))
+        })
+        .collect()
 }
 
 impl Plan {
@@ -65,10 +111,21 @@ impl Plan {
     pub fn new(
         n: usize,
         (mh, nnh): (usize, usize),
-        mass: &[Entry],
-        cq: &[Entry],
-        gm: &[Entry],
+        (mass, cq, gm): (&[Entry], &[Entry], &[Entry]),
+        added: &[usize],
     ) -> Option<Plan> {
+        let added = added
+            .iter()
+            .map(|&r| {
+                let row = cq
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, e)| e.row as usize == r)
+                    .map(|(k, e)| (e.col as usize, k))
+                    .collect();
+                (r, row)
+            })
+            .collect();
         let mut entries = HashMap::new();
         let mut adjacent = vec![BTreeSet::new(); n];
         let mut diagonal = vec![false; n];
@@ -154,11 +211,15 @@ impl Plan {
             operations: 0,
             n,
             entries,
+            added,
         };
         let mut operations = 0;
         for (k, terms) in plan.updates().iter().enumerate() {
             operations += 2 * terms.values().map(Vec::len).sum::<usize>() + 2;
             operations += 5 * plan.columns[k].len() + 2;
+        }
+        for (_, row) in &plan.added {
+            operations += 3 * row.len() * (row.len() + 2);
         }
         plan.operations = operations;
         Some(plan)
@@ -207,23 +268,52 @@ impl Plan {
         }
         let lit = Literal::usize_unsuffixed;
         let entry = |i: usize, k: usize| lit(index[&(i, k)]);
+        // The terms ρ J_ra J_rb of the rows added to M, by entry (a, b).
+        let mut terms: HashMap<(usize, usize), TokenStream> = HashMap::new();
+        let mut code = TokenStream::new();
+        for (a, (r, row)) in self.added.iter().enumerate() {
+            let rho = quote::format_ident!("rho{}", a);
+            let diagonal = row.iter().map(|&(c, _)| match self.entries[&(c, c)] {
+                Source::Mass(e) => lit(e),
+                _ => unreachable!("the row's columns are a block of M"),
+            });
+            let squares = row.iter().map(|&(_, e)| {
+                let e = lit(e);
+                quote!(cq[#e] * cq[#e])
+            });
+            code.extend(quote!(let #rho = (#(mass[#diagonal])+*) / (#(#squares)+*);));
+            let xr = lit(n + r);
+            for &(ca, ea) in row {
+                let (xa, ea) = (lit(ca), lit(ea));
+                code.extend(quote!(x[#xa] += #rho * cq[#ea] * x[#xr];));
+                for &(cb, eb) in row {
+                    let eb = lit(eb);
+                    terms
+                        .entry((ca, cb))
+                        .or_default()
+                        .extend(quote!(+ #rho * cq[#ea] * cq[#eb]));
+                }
+            }
+        }
         let source = |i: usize, k: usize| {
-            self.entries
-                .get(&(self.order[i], self.order[k]))
-                .map(|s| match *s {
-                    Source::Mass(e) => {
-                        let e = lit(e);
-                        quote!(mass[#e])
+            let (vi, vk) = (self.order[i], self.order[k]);
+            self.entries.get(&(vi, vk)).map(|s| match *s {
+                Source::Mass(e) => {
+                    let e = lit(e);
+                    match terms.get(&(vi, vk)) {
+                        Some(t) => quote!((mass[#e] #t)),
+                        None => quote!(mass[#e]),
                     }
-                    Source::Holonomic(e) => {
-                        let e = lit(e);
-                        quote!(cq[#e])
-                    }
-                    Source::Nonholonomic(e) => {
-                        let e = lit(e);
-                        quote!(g[#e])
-                    }
-                })
+                }
+                Source::Holonomic(e) => {
+                    let e = lit(e);
+                    quote!(cq[#e])
+                }
+                Source::Nonholonomic(e) => {
+                    let e = lit(e);
+                    quote!(g[#e])
+                }
+            })
         };
         // a − Σ l[ij] w[kj] (`a` absent: a structural zero).
         let update = |a: Option<TokenStream>, i: usize, k: usize, js: &[usize]| {
@@ -238,8 +328,7 @@ impl Plan {
             }
             e
         };
-        let ratio = crate::emit::expr::literal(PIVOT_RATIO).0;
-        let mut code = TokenStream::new();
+        let ratio: TokenStream = format!("{PIVOT_RATIO:e}").parse().expect("a literal");
         for (k, terms) in self.updates().iter().enumerate() {
             let v = self.order[k];
             let kl = lit(k);
@@ -256,25 +345,39 @@ impl Plan {
             } else {
                 let (coordinates, multipliers): (Vec<usize>, Vec<usize>) =
                     terms[&k].iter().partition(|&&j| self.order[j] < n);
-                let s = update(None, k, k, &coordinates);
+                // S_kk = Σ l w over the coordinates; −pivot = S_kk + Σ l w over the
+                // earlier multipliers (each l w < 0 there).
+                let products = |js: &[usize]| -> Vec<TokenStream> {
+                    js.iter()
+                        .map(|&j| {
+                            let kj = entry(k, j);
+                            quote!(l[#kj] * w[#kj])
+                        })
+                        .collect()
+                };
+                let (s, more) = (products(&coordinates), products(&multipliers));
                 let s = if s.is_empty() {
                     quote!(0.0)
                 } else {
-                    quote!(-(#s))
+                    quote!(#(#s)+*)
                 };
-                // −pivot = S_kk + Σ l w over the earlier multipliers (each l w < 0).
-                let mut d = quote!(s);
-                for &j in &multipliers {
-                    let kj = entry(k, j);
-                    d = quote!(#d + l[#kj] * w[#kj]);
-                }
-                code.extend(quote! {
-                    let s = #s;
-                    let d = #d;
-                    if !(d > #ratio * s) {
-                        return ::pfaff::__private::AugmentedSolve::Declined;
+                code.extend(if more.is_empty() {
+                    quote! {
+                        let s = #s;
+                        if !(s > 0.0) {
+                            return ::pfaff::__private::AugmentedSolve::Declined;
+                        }
+                        r[#kl] = -1.0 / s;
                     }
-                    r[#kl] = -1.0 / d;
+                } else {
+                    quote! {
+                        let s = #s;
+                        let d = s #(+ #more)*;
+                        if !(d > #ratio * s) {
+                            return ::pfaff::__private::AugmentedSolve::Declined;
+                        }
+                        r[#kl] = -1.0 / d;
+                    }
                 });
             }
             for &i in &self.columns[k] {
@@ -388,13 +491,13 @@ impl Plan {
 /// The trait method `augmented_solve` for the patterns, when the model profits from it:
 /// $M$ has every diagonal entry and the operation count is within [`BUDGET`].
 pub fn augmented_solve(
+    g: &Graph,
     n: usize,
     rows: (usize, usize),
-    mass: &[Entry],
-    cq: &[Entry],
-    gm: &[Entry],
+    (mass, cq, gm): (&[Entry], &[Entry], &[Entry]),
 ) -> TokenStream {
-    match Plan::new(n, rows, mass, cq, gm) {
+    let added = normalization_rows(g, mass, cq);
+    match Plan::new(n, rows, (mass, cq, gm), &added) {
         Some(plan) if plan.operations <= BUDGET && n > 0 => plan.emit(),
         _ => TokenStream::new(),
     }
