@@ -285,9 +285,7 @@ impl Dynamics {
         check_state(info, t, q, Some(qd))?;
         check_len(Quantity::Accelerations, qdd, n)?;
         check_len(Quantity::Multipliers, lambda, m)?;
-        ws.eval_mass_and_forces(mech, t, q, qd)?;
-        ws.eval_jacobian_values(mech, t, q)?;
-        ws.eval_gamma(mech, t, q, qd)?;
+        ws.eval_dynamics_terms(mech, t, q, qd)?;
         self.solve_evaluated(mech, ws, t, shift, qdd, lambda)
     }
 

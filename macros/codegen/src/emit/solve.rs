@@ -269,7 +269,7 @@ impl Plan {
         let lit = Literal::usize_unsuffixed;
         let entry = |i: usize, k: usize| lit(index[&(i, k)]);
         // The terms ρ J_ra J_rb of the rows added to M, by entry (a, b).
-        let mut terms: HashMap<(usize, usize), TokenStream> = HashMap::new();
+        let mut added: HashMap<(usize, usize), TokenStream> = HashMap::new();
         let mut code = TokenStream::new();
         for (a, (r, row)) in self.added.iter().enumerate() {
             let rho = quote::format_ident!("rho{}", a);
@@ -288,7 +288,7 @@ impl Plan {
                 code.extend(quote!(x[#xa] += #rho * cq[#ea] * x[#xr];));
                 for &(cb, eb) in row {
                     let eb = lit(eb);
-                    terms
+                    added
                         .entry((ca, cb))
                         .or_default()
                         .extend(quote!(+ #rho * cq[#ea] * cq[#eb]));
@@ -300,7 +300,7 @@ impl Plan {
             self.entries.get(&(vi, vk)).map(|s| match *s {
                 Source::Mass(e) => {
                     let e = lit(e);
-                    match terms.get(&(vi, vk)) {
+                    match added.get(&(vi, vk)) {
                         Some(t) => quote!((mass[#e] #t)),
                         None => quote!(mass[#e]),
                     }
@@ -333,7 +333,15 @@ impl Plan {
             let v = self.order[k];
             let kl = lit(k);
             if v < n {
-                let a = source(k, k).expect("a diagonal mass entry");
+                let mut a = source(k, k).expect("a diagonal mass entry");
+                if let Some(t) = added.get(&(v, v)) {
+                    let e = match self.entries[&(v, v)] {
+                        Source::Mass(e) => lit(e),
+                        _ => unreachable!("a diagonal mass entry"),
+                    };
+                    code.extend(quote!(let a = mass[#e] #t;));
+                    a = quote!(a);
+                }
                 let d = update(Some(a.clone()), k, k, &terms[&k]);
                 code.extend(quote! {
                     let d = #d;
