@@ -12,16 +12,21 @@ use pfaff::Mechanism;
 fn op_count_table() {
     println!("\noperation counts (naive tree = derivatives without simplification or sharing)");
     println!(
-        "{:<16} {:>14} {:>16} {:>10} {:>12}",
-        "model", "naive tree", "simplified tree", "emitted", "naive/emit"
+        "{:<16} {:>14} {:>16} {:>10} {:>12} {:>8}",
+        "model", "naive tree", "simplified tree", "emitted", "naive/emit", "rhs"
     );
     for (name, args, tokens) in pfaff_tests::sources::model_sources_with_args() {
         let c = pfaff_codegen::measure::op_counts(args, tokens).expect("model expands");
         #[allow(clippy::cast_precision_loss)]
-        let ratio = c.naive_tree as f64 / c.emitted.max(1) as f64;
+        let (naive, ratio) = c.naive_tree.map_or(("-".to_owned(), "-".to_owned()), |n| {
+            (
+                n.to_string(),
+                format!("{:.1}x", n as f64 / c.emitted.max(1) as f64),
+            )
+        });
         println!(
-            "{name:<16} {:>14} {:>16} {:>10} {ratio:>11.1}x",
-            c.naive_tree, c.simplified_tree, c.emitted
+            "{name:<16} {naive:>14} {:>16} {:>10} {ratio:>12} {:>8}",
+            c.simplified_tree, c.emitted, c.rhs
         );
     }
     println!();

@@ -18,12 +18,17 @@ use crate::{ctxt, model, parse, Analysis};
 /// Arithmetic operation counts of one model's generated functions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCounts {
-    /// Operations of the outputs as trees, derived without simplification.
-    pub naive_tree: u128,
+    /// Operations of the outputs as trees, derived without simplification; `None` where
+    /// the model cannot be derived without simplification (shape functions of deformable
+    /// bodies, whose linearity in `q_f` only the canonical graph shows).
+    pub naive_tree: Option<u128>,
     /// Operations of the simplified outputs as trees (simplification, no sharing).
     pub simplified_tree: u128,
     /// Operations of the emitted straight-line code (simplification and sharing).
     pub emitted: u64,
+    /// Operations of one right-hand side: the fused `dynamics_terms` (M, forces, C_q,
+    /// γ_h, G, γ_nh evaluated together, each shared node once).
+    pub rhs: u64,
 }
 
 /// The outputs of each generated function, in emission order.
@@ -62,17 +67,36 @@ pub fn op_counts(args: TokenStream, input: TokenStream) -> syn::Result<OpCounts>
         .map(|roots| transform::op_count(&analysis.graph, roots))
         .sum();
 
+    let d = &analysis.derived;
+    let e = |v: &[Entry]| v.iter().map(|e| e.expr).collect::<Vec<_>>();
+    let rhs_roots: Vec<ExprId> = [
+        e(&d.mass),
+        d.forces.clone(),
+        e(&d.cq),
+        d.gamma_h.clone(),
+        e(&d.gm),
+        d.gamma_nh.clone(),
+    ]
+    .concat();
+    let rhs = transform::op_count(&analysis.graph, &rhs_roots);
+
     let cx = ctxt::Ctxt::new();
     let ast = parse::parse(&cx, args, input).expect("parsed once already");
     let model = model::lower(&cx, ast);
     let mut raw = Graph::raw();
-    let naive = derive::derive(&cx, &model, &mut raw).expect("derived once already");
+    // Deformable bodies given by shape functions need the canonical graph's
+    // simplification to recognize `N(ξ) q_f` as linear: their naive tree is not counted.
+    let naive = derive::derive(&cx, &model, &mut raw);
     let _ = cx.check();
-    let naive_all: Vec<ExprId> = functions(&naive).into_iter().flatten().collect();
+    let naive_tree = naive.map(|naive| {
+        let naive_all: Vec<ExprId> = functions(&naive).into_iter().flatten().collect();
+        transform::tree_op_count(&raw, &naive_all)
+    });
     Ok(OpCounts {
-        naive_tree: transform::tree_op_count(&raw, &naive_all),
+        naive_tree,
         simplified_tree,
         emitted,
+        rhs,
     })
 }
 
@@ -183,7 +207,7 @@ mod tests {
             }
         };
         let counts = super::op_counts(quote!(), model).expect("the model derives");
-        assert!(counts.naive_tree >= counts.simplified_tree);
+        assert!(counts.naive_tree.expect("a rigid body derives raw") >= counts.simplified_tree);
         assert!(counts.simplified_tree >= u128::from(counts.emitted));
     }
 }

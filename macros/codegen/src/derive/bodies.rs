@@ -3,8 +3,10 @@
 //!
 //! Input: the model's body-level declarations, in order (each may use the frames and
 //! points above it). Output: [`BodyLevel`], which adds to what the generalized-coordinate
-//! level derives from: the kinetic energy of every body (from the velocity of its centre
-//! of mass and its angular velocity, both derived from the kinematics), the potential of
+//! level derives from: every rigid body's mass matrix and inertia forces by Kane's method
+//! (from the partial velocities of its centre of mass and of its angular velocity, both
+//! derived from the kinematics; see `Builder::kane`), its kinetic energy for the
+//! reported energy, the potential of
 //! gravity and springs, the applied generalized forces of force elements (by virtual
 //! power, `Q_i = F·∂v_P/∂q̇_i`), and named constraint rows: joints expand to holonomic
 //! rows, rolling and knife edges to non-holonomic ones, and every frame oriented by Euler
@@ -83,7 +85,18 @@ pub struct BodyLevel {
     pub joints: Vec<JointOut>,
     pub holonomic: Vec<Row>,
     pub nonholonomic: Vec<Row>,
+    /// The kinetic energy of every body (for the energy the run reports).
     pub kinetic: ExprId,
+    /// The part of [`Self::kinetic`] whose mass matrix and quadratic velocity forces come
+    /// from Lagrange's equations (deformable bodies); rigid bodies give theirs in
+    /// [`Self::mass`] and [`Self::inertial`] instead.
+    pub lagrange_kinetic: ExprId,
+    /// The rigid bodies' mass matrix by Kane's method, `(row, column, entry)` with both
+    /// triangles, in row-major order, structural zeros left out.
+    pub mass: Vec<(u32, u32, ExprId)>,
+    /// The rigid bodies' generalized inertia forces at `q̈ = 0` (the quadratic velocity
+    /// vector with its sign in `M q̈ = Q`), length `n`.
+    pub inertial: Vec<ExprId>,
     pub potential: ExprId,
     /// Applied generalized forces of force elements, length `n`.
     pub applied: Vec<ExprId>,
@@ -98,6 +111,14 @@ pub struct BodyLevel {
     pub drawing: DrawingOut,
     /// Contacts between points and surfaces (`Contact` items), as gaps.
     pub contacts: Vec<ContactRow>,
+}
+
+/// The inertia of a rigid motion in [`Builder::kane`].
+enum Inertia {
+    /// A mass (or a planar moment of inertia): the same for every component.
+    Scalar(ExprId),
+    /// A symmetric inertia tensor, row-major.
+    Matrix(Vec<ExprId>),
 }
 
 fn idx(i: usize) -> u32 {
@@ -295,6 +316,11 @@ struct Builder<'t, 'a> {
     defaults: Vec<f64>,
     out: BodyLevel,
     kinetic: Vec<ExprId>,
+    lagrange_kinetic: Vec<ExprId>,
+    /// Kane's mass-matrix terms per `(row, column)`, upper triangle.
+    kane_mass: std::collections::BTreeMap<(u32, u32), Vec<ExprId>>,
+    /// Kane's generalized inertia force terms per coordinate.
+    kane_forces: Vec<Vec<ExprId>>,
     potential: Vec<ExprId>,
     /// `(mass, centre of mass)` of each body, for gravity.
     masses: Vec<(ExprId, Vec<ExprId>)>,
@@ -326,6 +352,9 @@ pub fn expand<'a>(
             holonomic: Vec::new(),
             nonholonomic: Vec::new(),
             kinetic: zero,
+            lagrange_kinetic: zero,
+            mass: Vec::new(),
+            inertial: vec![zero; n],
             potential: zero,
             applied: vec![zero; n],
             has_applied: false,
@@ -335,6 +364,9 @@ pub fn expand<'a>(
             contacts: Vec::new(),
         },
         kinetic: Vec::new(),
+        lagrange_kinetic: Vec::new(),
+        kane_mass: std::collections::BTreeMap::new(),
+        kane_forces: vec![Vec::new(); n],
         potential: Vec::new(),
         masses: Vec::new(),
         gravity: None,
@@ -434,6 +466,23 @@ pub fn expand<'a>(
         b.up.as_deref(),
     );
     b.out.kinetic = g.add(std::mem::take(&mut b.kinetic));
+    b.out.lagrange_kinetic = g.add(std::mem::take(&mut b.lagrange_kinetic));
+    for (i, terms) in std::mem::take(&mut b.kane_forces).into_iter().enumerate() {
+        b.out.inertial[i] = g.add(terms);
+    }
+    let mut mass = Vec::new();
+    for ((i, j), terms) in std::mem::take(&mut b.kane_mass) {
+        let m = g.add(terms);
+        if g.is_canonical() && g.is_zero(m) {
+            continue;
+        }
+        mass.push((i, j, m));
+        if i != j {
+            mass.push((j, i, m));
+        }
+    }
+    mass.sort_by_key(|&(i, j, _)| (i, j));
+    b.out.mass = mass;
     b.out.potential = g.add(std::mem::take(&mut b.potential));
     Some(b.out)
 }
@@ -682,6 +731,7 @@ impl<'a> Builder<'_, 'a> {
         let vv = dot(self.g(), &vc, &vc);
         let half = self.g().constant(0.5);
         let mut terms = vec![self.g().mul(vec![half, mass, vv])];
+        self.kane(&vc, &Inertia::Scalar(mass), None);
         let mut principal = Vec::new();
         if let Some(ie) = fl.get("inertia") {
             if dim == 2 {
@@ -691,6 +741,7 @@ impl<'a> Builder<'_, 'a> {
                     unreachable!("planar frames have a scalar rate")
                 };
                 terms.push(self.g().mul(vec![half, i, w, w]));
+                self.kane(&[w], &Inertia::Scalar(i), None);
             } else {
                 let inertia = match self.tr.field_value(ie, Context::Kinematics)? {
                     Value::Matrix(3, m) => m,
@@ -720,6 +771,8 @@ impl<'a> Builder<'_, 'a> {
                 let iw = mat_vec(self.g(), 3, &inertia, &w);
                 let wiw = dot(self.g(), &w, &iw);
                 terms.push(self.g().mul(vec![half, wiw]));
+                let gyroscopic = cross(self.g(), &w, &iw);
+                self.kane(&w, &Inertia::Matrix(inertia.clone()), Some(&gyroscopic));
             }
         }
         let t = self.g().add(terms);
@@ -737,6 +790,50 @@ impl<'a> Builder<'_, 'a> {
             mass,
         });
         Some(())
+    }
+
+    /// Adds one rigid motion's generalized inertia forces by Kane's method. `u` is a
+    /// velocity linear in `q̇` (a centre of mass's, or an angular velocity in body axes)
+    /// with the inertia `inertia`, and `gyroscopic` the force that does not come from
+    /// `u̇` (`ω̄ × Īω̄`). With the partial velocities `J = ∂u/∂q̇` and `a = ∂u/∂q q̇ + ∂u/∂t`
+    /// (`u̇` at `q̈ = 0`), it adds `J_iᵀ K J_j` to `M` and `−J_iᵀ (K a + gyroscopic)` to the
+    /// forces. For independent coordinates this equals Lagrange's `∂T/∂q − Ṁq̇`; for Euler
+    /// parameters the two differ by a multiple of the normalization's gradient, which its
+    /// multiplier absorbs.
+    fn kane(&mut self, u: &[ExprId], inertia: &Inertia, gyroscopic: Option<&[ExprId]>) {
+        let nq = self.tr.nq();
+        let k = u.len();
+        let g = &mut *self.tr.g;
+        let zero = g.constant(0.0);
+        let mut cols: std::collections::BTreeMap<u32, Vec<ExprId>> =
+            std::collections::BTreeMap::new();
+        for (c, &uc) in u.iter().enumerate() {
+            diff::for_each_partial(g, uc, nq, Var::Qd, &mut |_, j, d| {
+                cols.entry(j).or_insert_with(|| vec![zero; k])[c] = d;
+            });
+        }
+        let apply = |g: &mut Graph, v: &[ExprId]| match inertia {
+            Inertia::Scalar(m) => scale_v(g, *m, v),
+            Inertia::Matrix(m) => mat_vec(g, k, m, v),
+        };
+        let bias: Vec<ExprId> = u.iter().map(|&x| time_derivative(g, nq, x)).collect();
+        let mut f = apply(g, &bias);
+        if let Some(h) = gyroscopic {
+            f = add_v(g, &f, h);
+        }
+        let weighted: Vec<(u32, Vec<ExprId>)> =
+            cols.iter().map(|(&j, c)| (j, apply(g, c))).collect();
+        for (&i, ci) in &cols {
+            let fi = dot(g, ci, &f);
+            let neg = g.neg(fi);
+            self.kane_forces[i as usize].push(neg);
+            for (j, kcj) in &weighted {
+                if *j >= i {
+                    let mij = dot(g, ci, kcj);
+                    self.kane_mass.entry((i, *j)).or_default().push(mij);
+                }
+            }
+        }
     }
 
     fn point(&mut self, d: &Decl) -> Option<()> {

@@ -93,7 +93,6 @@ pub fn derive(
 ) -> Option<Contacts> {
     let n = model.nq();
     let qv: Vec<ExprId> = (0..n).map(|i| g.var(Var::Qd(idx(i)))).collect();
-    let qd_pairs: Vec<(Var, ExprId)> = (0..n).map(|i| (Var::Q(idx(i)), qv[i])).collect();
     let mut out = Contacts::default();
     let mut ok = true;
     for c in rows.iter().flatten() {
@@ -157,9 +156,7 @@ pub fn derive(
         let rate = diff::differentiate(g, gap, Var::Time);
         rate_terms.push(rate);
         let vn = g.add(rate_terms);
-        let along = diff::directional(g, vn, &qd_pairs);
-        let dt = diff::differentiate(g, vn, Var::Time);
-        let s = g.add(vec![along, dt]);
+        let s = diff::rate(g, vn);
         let gamma = g.neg(s);
         roots.extend([rate, gamma]);
         if checking {

@@ -1,8 +1,9 @@
 //! Deformable bodies in the floating frame of reference (math-spec §2–§3).
 //!
 //! `static rod: Body = Deformable { origin, angle | rotation, elastic: [q1, ..], .. }`
-//! declares a body whose material point `ξ` sits at `R + A (ū_o(ξ) + N(ξ) q_f)`. Like a
-//! rigid body it adds kinetic energy, not a mass matrix: from the inertia shape
+//! declares a body whose material point `ξ` sits at `R + A (ū_o(ξ) + N(ξ) q_f)`. Unlike a
+//! rigid body (Kane's method) it adds kinetic energy, whose mass matrix and quadratic
+//! velocity vector come from Lagrange's equations: from the inertia shape
 //! integrals (E10) `m, Ī₁, S̄, I_kl, Ī_kl, S̄_kl` (symbolic leaves: numbers, parameter
 //! expressions) it forms
 //!
@@ -377,6 +378,7 @@ impl Builder<'_, '_> {
         let inv = self.invariants(fl, &shapes, dim, nf)?;
         let t = self.deformable_kinetic(&fv, &inv, &qf);
         self.kinetic.push(t);
+        self.lagrange_kinetic.push(t);
 
         // Elastic energy and damping.
         let qv: Vec<ExprId> = qf.iter().map(|&i| self.tr.g.var(Var::Q(i))).collect();

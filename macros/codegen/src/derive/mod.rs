@@ -215,6 +215,9 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     drop(tr);
     let mut body_level = body_level;
     let (mut kinetic, mut potential) = (kinetic, potential);
+    // The kinetic energy Lagrange's equations differentiate: the user's, and that of
+    // deformable bodies; rigid bodies add their M and Q_v by Kane's method below.
+    let mut lagrange_kinetic = kinetic;
     if let Some(bl) = &mut body_level {
         // Body-level rows follow the user's rows: shift the joints' row ranges.
         let (nh0, nnh0) = (idx(holonomic.len()), idx(nonholonomic.len()));
@@ -231,6 +234,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         holonomic.extend(bl.holonomic.drain(..).map(Some));
         nonholonomic.extend(bl.nonholonomic.drain(..).map(Some));
         kinetic = kinetic.map(|k| g.add(vec![k, bl.kinetic]));
+        lagrange_kinetic = lagrange_kinetic.map(|k| g.add(vec![k, bl.lagrange_kinetic]));
         potential = potential.map(|v| g.add(vec![v, bl.potential]));
         for (i, a) in applied.iter_mut().enumerate() {
             *a = a.map(|a| g.add(vec![a, bl.applied[i]]));
@@ -243,13 +247,13 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         return None;
     }
     let t_kin = kinetic?;
+    let t_lagrange = lagrange_kinetic?;
     let v_pot = potential?;
     let qv: Vec<ExprId> = (0..n).map(|i| g.var(Var::Qd(idx(i)))).collect();
-    let qd_pairs: Vec<(Var, ExprId)> = (0..n).map(|i| (Var::Q(idx(i)), qv[i])).collect();
 
     // Mass matrix and quadratic-velocity forces from T.
     let momenta: Vec<ExprId> = (0..n)
-        .map(|i| diff::differentiate(g, t_kin, Var::Qd(idx(i))))
+        .map(|i| diff::differentiate(g, t_lagrange, Var::Qd(idx(i))))
         .collect();
     let mut mass = Vec::new();
     for i in 0..n {
@@ -266,19 +270,22 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             });
         }
     }
+    if let Some(bl) = &body_level {
+        mass = merge_mass(g, &mass, &bl.mass);
+    }
+    let zero_q = g.constant(0.0);
     let mut forces = Vec::with_capacity(n);
     let mut applied_forces = Vec::with_capacity(n);
     for i in 0..n {
         let qi = Var::Q(idx(i));
-        let dt_dq = diff::differentiate(g, t_kin, qi);
-        let conv = diff::directional(g, momenta[i], &qd_pairs);
-        let dp_dt = diff::differentiate(g, momenta[i], Var::Time);
+        let dt_dq = diff::differentiate(g, t_lagrange, qi);
+        let dp = diff::rate(g, momenta[i]);
         let dv_dq = diff::differentiate(g, v_pot, qi);
         let qe = applied[i]?;
-        let neg_conv = g.neg(conv);
-        let neg_dpdt = g.neg(dp_dt);
+        let neg_dp = g.neg(dp);
         let neg_dv = g.neg(dv_dq);
-        forces.push(g.add(vec![qe, dt_dq, neg_conv, neg_dpdt, neg_dv]));
+        let kane = body_level.as_ref().map_or(zero_q, |bl| bl.inertial[i]);
+        forces.push(g.add(vec![qe, dt_dq, neg_dp, neg_dv, kane]));
         applied_forces.push(qe);
     }
     let mut has_virtual_work = false;
@@ -318,9 +325,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         let h_t = diff::differentiate(g, h, Var::Time);
         rate_terms.push(h_t);
         let cdot = g.add(rate_terms);
-        let along = diff::directional(g, cdot, &qd_pairs);
-        let dt = diff::differentiate(g, cdot, Var::Time);
-        let s = g.add(vec![along, dt]);
+        let s = diff::rate(g, cdot);
         c.push(h);
         ct.push(h_t);
         gamma_h.push(g.neg(s));
@@ -361,9 +366,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             _ => None,
         });
         gb.push(bias);
-        let along = diff::directional(g, nh, &qd_pairs);
-        let dt = diff::differentiate(g, nh, Var::Time);
-        let s = g.add(vec![along, dt]);
+        let s = diff::rate(g, nh);
         gamma_nh.push(g.neg(s));
     }
     if checking && cx.has_errors() {
@@ -507,6 +510,24 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
         derived.linear = Some(linear::derive(g, &derived, n));
     }
     Some(derived)
+}
+
+/// The sum of two mass matrices given as row-major entry lists (structural zeros left out).
+fn merge_mass(g: &mut Graph, a: &[Entry], b: &[(u32, u32, ExprId)]) -> Vec<Entry> {
+    let mut sum: std::collections::BTreeMap<(u32, u32), Vec<ExprId>> =
+        std::collections::BTreeMap::new();
+    for e in a {
+        sum.entry((e.row, e.col)).or_default().push(e.expr);
+    }
+    for &(row, col, expr) in b {
+        sum.entry((row, col)).or_default().push(expr);
+    }
+    sum.into_iter()
+        .filter_map(|((row, col), terms)| {
+            let expr = g.add(terms);
+            (!(g.is_canonical() && g.is_zero(expr))).then_some(Entry { row, col, expr })
+        })
+        .collect()
 }
 
 /// The entries of row `r` of a pattern-ordered matrix.

@@ -17,7 +17,7 @@
 use quote::ToTokens;
 
 use super::expr::Translator;
-use crate::sym::{diff, ExprId, Graph, Var};
+use crate::sym::{diff, ExprId, Graph};
 
 /// The value of an expression.
 #[derive(Clone, Debug, PartialEq)]
@@ -162,16 +162,8 @@ pub fn transpose(n: usize, m: &[ExprId]) -> Vec<ExprId> {
 }
 
 /// `d/dt e` along the motion: `Σ ∂e/∂q_i q̇_i + ∂e/∂t`.
-pub fn time_derivative(g: &mut Graph, nq: usize, e: ExprId) -> ExprId {
-    let pairs: Vec<(Var, ExprId)> = (0..nq)
-        .map(|i| {
-            let i = u32::try_from(i).expect("coordinate count fits u32");
-            (Var::Q(i), g.var(Var::Qd(i)))
-        })
-        .collect();
-    let along = diff::directional(g, e, &pairs);
-    let dt = diff::differentiate(g, e, Var::Time);
-    g.add(vec![along, dt])
+pub fn time_derivative(g: &mut Graph, _nq: usize, e: ExprId) -> ExprId {
+    diff::rate(g, e)
 }
 
 pub fn rot2(g: &mut Graph, a: ExprId) -> Vec<ExprId> {

@@ -66,6 +66,53 @@ pub fn differentiate(g: &mut Graph, e: ExprId, v: Var) -> ExprId {
     d
 }
 
+/// The rate of `e` along the motion at `q̈ = 0`: `Σ_i ∂e/∂q_i · q̇_i + ∂e/∂t`, with the
+/// velocities (and every other variable) held fixed.
+///
+/// Forward mode: each node's rate is built from its operands' rates and the operation's
+/// partials (`op.rs`), memoised per node, so the result is one pass over `e`'s DAG. The
+/// same sum by [`directional`] builds a partial derivative per coordinate, each a walk of
+/// the expression, and adds them: for the velocities and accelerations of a spatial
+/// mechanism, whose positions depend on many coordinates through shared rotations, that
+/// is several times larger (see ARCHITECTURE.md, "The body level").
+pub fn rate(g: &mut Graph, e: ExprId) -> ExprId {
+    let moving = Deps::Q.bits() | Deps::TIME.bits();
+    if g.deps(e).bits() & moving == 0 {
+        return g.constant(0.0);
+    }
+    if let Some(&d) = g.rate_memo.get(&e) {
+        return d;
+    }
+    let d = match g.node(e).clone() {
+        Node::Const(_) => g.constant(0.0),
+        Node::Var(Var::Q(i)) => g.var(Var::Qd(i)),
+        Node::Var(Var::Time) => g.constant(1.0),
+        Node::Var(_) => g.constant(0.0),
+        _ => {
+            let args = g.node(e).args();
+            let keep: Vec<bool> = args
+                .iter()
+                .map(|&a| g.deps(a).bits() & moving != 0)
+                .collect();
+            let pairs = partials_where(g, e, &|k| keep[k]);
+            let mut terms = Vec::new();
+            for (arg, partial) in pairs {
+                if g.deps(arg).bits() & moving == 0 {
+                    continue;
+                }
+                let da = rate(g, arg);
+                if g.is_canonical() && g.is_zero(da) {
+                    continue;
+                }
+                terms.push(g.mul(vec![partial, da]));
+            }
+            g.add(terms)
+        }
+    };
+    g.rate_memo.insert(e, d);
+    d
+}
+
 /// The directional derivative `Σ_i ∂e/∂x_i · w_i` for pairs `(x_i, w_i)`.
 ///
 /// Variables absent from `e` are skipped once `e` is primed for their kind (the first

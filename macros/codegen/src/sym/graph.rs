@@ -147,6 +147,8 @@ pub struct Graph {
     lookup: HashMap<Node, ExprId>,
     canonical: bool,
     pub(crate) diff_memo: HashMap<(ExprId, Var), ExprId>,
+    /// Memo of `diff::rate`.
+    pub(crate) rate_memo: HashMap<ExprId, ExprId>,
     /// Per node, its variable set once computed (lazily, by [`Graph::var_set`]).
     vars: Vec<Option<VarSet>>,
     /// Per node, the kinds ([`Deps`] bits) for which differentiation has visited the
@@ -187,6 +189,7 @@ impl Graph {
             lookup: HashMap::new(),
             canonical: true,
             diff_memo: HashMap::new(),
+            rate_memo: HashMap::new(),
             vars: Vec::new(),
             primed: Vec::new(),
             skip_absent: true,

@@ -414,3 +414,42 @@ fn skipping_absent_variables_builds_the_graph_of_the_full_walk() {
         .iter()
         .any(|&e| !matches!(skip_nodes[e.index()], Node::Const(_))));
 }
+
+#[test]
+fn rates_match_central_differences_along_the_motion() {
+    // `rate(e)` is de/ds along q(s) = q + s·q̇, t(s) = t + s with q̇ held (q̈ = 0).
+    let mut rng = Rng(0x4A7E);
+    let mut checked = 0;
+    for _ in 0..300 {
+        let mut g = Graph::new();
+        let e = random_expr(&mut g, &mut rng, 4);
+        let r = diff::rate(&mut g, e);
+        let (q, qd, t) = (
+            [rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5)],
+            [rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5)],
+            rng.uniform(-1.5, 1.5),
+        );
+        let at = |s: f64| {
+            move |v: Var| match v {
+                Var::Q(i) => q[i as usize] + s * qd[i as usize],
+                Var::Qd(i) => qd[i as usize],
+                Var::Time => t + s,
+                _ => f64::NAN,
+            }
+        };
+        let h = 1e-5;
+        let (fp, fm) = (eval(&g, &[e], &at(h))[0], eval(&g, &[e], &at(-h))[0]);
+        let fd = (fp - fm) / (2.0 * h);
+        let an = eval(&g, &[r], &at(0.0))[0];
+        if !fd.is_finite() || !an.is_finite() || fd.abs() > 1e4 {
+            continue;
+        }
+        let scale = fp.abs().max(fm.abs());
+        assert!(
+            (fd - an).abs() <= 1e-5 * (1.0 + an.abs()) + 1e-9 * scale / h,
+            "rate: symbolic {an} vs central difference {fd}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 200, "enough rates were compared: {checked}");
+}

@@ -24,10 +24,13 @@ const GSTR: [f64; 14] = [
     0.00524, 0.00468,
 ];
 
-/// $2^i$, 1-based.
-const TWO: [f64; 14] = [
-    1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0, 1024.0, 2048.0, 4096.0, 8192.0,
-];
+/// The step size aims at $\text{erk} = \text{AIM}\cdot\tfrac12\varepsilon = \varepsilon/32$
+/// (`STEP`: $\tfrac12\varepsilon$); see the module docs of [`super`].
+const AIM: f64 = 1.0 / 16.0;
+
+/// The step size is kept while $\text{erk}$ lies within a factor `BAND` below the aim
+/// (`STEP`: $2^{k+1}$, so that only doubling is possible).
+const BAND: f64 = 32.0;
 
 /// Error estimates of block 2.
 #[derive(Clone, Copy, Debug)]
@@ -392,10 +395,17 @@ impl Adams {
         }
         let h = self.h;
         let mut hnew = h + h;
-        if !self.phase1 && p5eps < erk * TWO[self.k + 1] {
+        if !self.phase1 {
+            // The step size aims at erk = AIM·ε/2: it grows to that aim as soon as erk has
+            // fallen a factor BAND below it, and shrinks as soon as erk exceeds it.
+            let aim = AIM * p5eps;
+            let expo = 1.0 / (self.k + 1) as f64;
             hnew = h;
-            if p5eps < erk {
-                let r = (p5eps / erk).powf(1.0 / (self.k + 1) as f64);
+            if erk * BAND <= aim {
+                // erk = 0 (a polynomial solution) doubles.
+                hnew = h * (aim / erk).powf(expo).min(2.0);
+            } else if erk > aim {
+                let r = (aim / erk).powf(expo);
                 let a = absh * r.clamp(0.5, 0.9);
                 hnew = a.max(4.0 * UROUND * self.x.abs()).copysign(h);
             }
