@@ -8,9 +8,12 @@
 //!   \quad \gamma = \begin{bmatrix}\gamma_h\\ \gamma_{nh}\end{bmatrix},$$
 //! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of math-spec §1).
 //!
-//! **Paths.** A dense $LU$ with complete pivoting for small systems, a sparse $LU$
-//! (symbolic factorization once from the patterns, numeric each call) for large ones;
-//! [`LinearSolver::Auto`] switches at [`DynamicsParams::crossover`] unknowns.
+//! **Paths.** The model's own solve ([`Mechanism::augmented_solve`]: a sparse
+//! $LDL^\mathsf{T}$ the generator specialized to the patterns of $M$ and $J$, every
+//! pivot checked) when it has one and its pivots are safe; otherwise a dense $LU$ for
+//! small systems, a sparse $LU$ (symbolic factorization once from the patterns,
+//! numeric each call) for large ones; [`LinearSolver::Auto`] takes the model's solve
+//! first and switches from dense to sparse at [`DynamicsParams::crossover`] unknowns.
 //!
 //! **Redundant constraints.** When the dense pivots (ratio below
 //! [`DynamicsParams::rank_tolerance`]) or the sparse residual reveal a singular
@@ -42,12 +45,14 @@ use crate::workspace::{
     check_finite, check_len, check_same_model, check_state, scatter_row_major, EvalError, Quantity,
     Workspace,
 };
-use crate::{Info, Mechanism};
+use crate::{AugmentedSolve, Info, Mechanism};
 
 /// Choice of the linear solver for the augmented system.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LinearSolver {
-    /// Dense below [`DynamicsParams::crossover`] unknowns, sparse from there on.
+    /// The model's generated solve ([`Mechanism::augmented_solve`]) when it has one
+    /// and accepts the system; otherwise dense below [`DynamicsParams::crossover`]
+    /// unknowns, sparse from there on.
     #[default]
     Auto,
     /// Always dense.
@@ -105,6 +110,8 @@ pub const DEFAULT_CROSSOVER: usize = 16;
 /// Which path solved the system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SolverPath {
+    /// The model's generated solve ([`Mechanism::augmented_solve`]).
+    Generated,
     /// Dense complete-pivoting $LU$.
     Dense,
     /// Sparse $LU$.
@@ -120,7 +127,8 @@ pub struct AccelerationStats {
     pub path: SolverPath,
     /// Numerical rank of $J$ ($= m$ unless [`SolverPath::Redundant`]).
     pub rank: usize,
-    /// Smallest / largest pivot of the dense factorization used (1 on the sparse path).
+    /// Smallest / largest pivot of the dense factorization used (1 on the sparse and
+    /// the generated paths).
     pub pivot_ratio: f64,
 }
 
@@ -175,6 +183,8 @@ pub struct Dynamics {
     small: Option<SmallLu>,
     dense: Option<DenseLu>,
     sparse: Option<SparseKkt>,
+    /// Whether to try the model's generated solve (cleared when it has none).
+    generated: bool,
     x: Vec<f64>,
     b: Vec<f64>,
     r: Vec<f64>,
@@ -205,6 +215,7 @@ impl Dynamics {
             small: dense.then(|| SmallLu::new(dim)),
             dense: dense.then(|| DenseLu::new(dim, 1)),
             sparse,
+            generated: params.solver == LinearSolver::Auto,
             x: vec![0.0; dim],
             b: vec![0.0; dim],
             r: vec![0.0; dim],
@@ -274,16 +285,15 @@ impl Dynamics {
         check_state(info, t, q, Some(qd))?;
         check_len(Quantity::Accelerations, qdd, n)?;
         check_len(Quantity::Multipliers, lambda, m)?;
-        ws.eval_mass_and_forces(mech, t, q, qd)?;
-        ws.eval_jacobian_values(mech, t, q)?;
-        ws.eval_gamma(mech, t, q, qd)?;
-        self.solve_evaluated(ws, t, shift, qdd, lambda)
+        ws.eval_dynamics_terms(mech, t, q, qd)?;
+        self.solve_evaluated(mech, ws, t, shift, qdd, lambda)
     }
 
     /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
     /// $\gamma$ already evaluated in `ws` (lengths checked by the caller).
-    pub(crate) fn solve_evaluated(
+    pub(crate) fn solve_evaluated<M: Mechanism + ?Sized>(
         &mut self,
+        mech: &M,
         ws: &mut Workspace,
         t: f64,
         shift: Option<&[f64]>,
@@ -301,6 +311,23 @@ impl Dynamics {
         }
         self.redundant.clear();
 
+        if self.generated {
+            self.x.copy_from_slice(&self.b);
+            match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, &mut self.x) {
+                // A non-finite result goes to the general path, which reports it.
+                AugmentedSolve::Solved if self.x.iter().all(|v| v.is_finite()) => {
+                    qdd.copy_from_slice(&self.x[..n]);
+                    lambda.copy_from_slice(&self.x[n..]);
+                    return Ok(AccelerationStats {
+                        path: SolverPath::Generated,
+                        rank: m,
+                        pivot_ratio: 1.0,
+                    });
+                }
+                AugmentedSolve::Unavailable => self.generated = false,
+                AugmentedSolve::Solved | AugmentedSolve::Declined => {}
+            }
+        }
         let small = self.small.as_mut().and_then(|lu| {
             fill_small(lu, info, ws);
             let ratio = lu.factor().ratio();

@@ -84,8 +84,8 @@ pub use linearize::{
     LinearizeParams, StateComponent, States,
 };
 pub use mechanism::{
-    Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind, Mechanism,
-    Parameter, Pattern, Point, Symbol, TimeDependence,
+    AugmentedSolve, Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint,
+    JointKind, Mechanism, Parameter, Pattern, Point, Symbol, TimeDependence,
 };
 pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
 pub use pose::{isometry2_from_raw, isometry_from_raw, quaternion_from_raw, PoseExt};
@@ -100,7 +100,7 @@ pub mod __private {
     pub use crate::drawing::{DrawPoint, Drawing, Shape, ShapeKind};
     pub use crate::flex;
     pub use crate::mechanism::{
-        Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint, JointKind,
-        Mechanism, Parameter, Point, Symbol, TimeDependence,
+        AugmentedSolve, Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint,
+        JointKind, Mechanism, Parameter, Point, Symbol, TimeDependence,
     };
 }

@@ -353,6 +353,19 @@ pub struct DynamicsTerms<'a> {
     pub nonholonomic_gamma: &'a mut [f64],
 }
 
+/// The outcome of [`Mechanism::augmented_solve`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AugmentedSolve {
+    /// The model has no specialized solve (the default).
+    Unavailable,
+    /// Solved: the buffer holds $[\ddot q; \lambda]$.
+    Solved,
+    /// A pivot was not safely positive (a mass matrix singular off the constraints,
+    /// redundant or nearly dependent constraints, a singular configuration): the buffer
+    /// holds nothing useful, and the general path must solve.
+    Declined,
+}
+
 /// A mechanism: the functions that `#[pfaff::mechanism]` generates.
 ///
 /// All matrices are written as the values of their pattern entries (see [`Info`]).
@@ -489,6 +502,29 @@ pub trait Mechanism {
         self.holonomic_gamma(t, q, qd, out.holonomic_gamma);
         self.nonholonomic_matrix(t, q, out.nonholonomic_matrix);
         self.nonholonomic_gamma(t, q, qd, out.nonholonomic_gamma);
+    }
+
+    /// Solves the augmented system
+    /// $[M\ J^\mathsf{T}; J\ 0][\ddot q; \lambda] = [Q; \gamma]$,
+    /// $J = [C_q; G]$, in place: `x` holds $[Q; \gamma]$ (length `n + m_h + m_nh`) on
+    /// entry and $[\ddot q; \lambda]$ on return, from the pattern values `mass`, `cq`
+    /// and `g` (as written by [`dynamics_terms`](Self::dynamics_terms)).
+    ///
+    /// The generator emits it, specialized to the model's patterns (a sparse
+    /// $LDL^\mathsf{T}$ with the fill and the elimination order computed at compile
+    /// time, coordinates first, then multipliers), when that pays; every pivot is
+    /// checked, and [`AugmentedSolve::Declined`] hands the system back to the general
+    /// path ([`Dynamics`](crate::Dynamics)). The default returns
+    /// [`AugmentedSolve::Unavailable`]. Allocates nothing.
+    fn augmented_solve(
+        &self,
+        mass: &[f64],
+        cq: &[f64],
+        g: &[f64],
+        x: &mut [f64],
+    ) -> AugmentedSolve {
+        let _ = (mass, cq, g, x);
+        AugmentedSolve::Unavailable
     }
 
     /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin

@@ -4,14 +4,19 @@
 //! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C_q$,
 //!   $\gamma$, $G$), of `holonomic` ($C$) and of `holonomic_jacobian` ($C_q$): what
 //!   every formulation evaluates at least once per point;
+//! - `generated+solve`: `dynamics_terms` and the model's generated `augmented_solve`
+//!   ($\ddot q$ and $\lambda$ from $M$, $Q$, $J$, $\gamma$): the index-1 right-hand
+//!   side in generated code alone, the floor of every formulation's;
 //! - `partitioning`, `projection`, `baumgarte`: one `rhs` of [`StateSpace`] at a moving
 //!   state off the constraint manifold by a predictor's error (an Euler step of 1e-3
 //!   of the motion's time scale from a consistent state), alternating between two such
 //!   states so that nothing is reused from the previous call; partitioning does its
 //!   usual Newton update there.
 //!
-//! Models: `pendulum` and `andrews`. Another model is one entry of [`CASES`] (the
-//! 100-body chain of the body-level generator is the next one).
+//! Models: `pendulum`, `andrews` and `chain10` (the spatial chain of 10 rods on ball
+//! joints, Euler parameters: n = 70, 40 constraints). Another model is one entry of
+//! [`CASES`]; the 100-link chain is not compiled into the built-in models (see
+//! ARCHITECTURE.md, body-level generator).
 //!
 //! `cargo bench -p pfaff-tests --bench rhs [-- andrews]`
 
@@ -20,7 +25,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use pfaff::ode::OdeSystem;
 use pfaff::sim::{Formulation, Method, Simulation, StateSpace};
-use pfaff::{DynamicsTerms, Mechanism};
+use pfaff::{AugmentedSolve, DynamicsTerms, Mechanism};
 
 /// A model, and the time after which its state is moving (taken by a tight run from
 /// its initial state) and its motion's time scale.
@@ -38,6 +43,12 @@ const CASES: &[Case] = &[
         || Box::new(pfaff_models::andrews::Model::default()),
         0.01,
         1e-3,
+    ),
+    (
+        "chain10",
+        || Box::new(pfaff_models::chain10::Model::default()),
+        0.05,
+        0.01,
     ),
 ];
 
@@ -86,11 +97,50 @@ fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[
     });
 }
 
+fn generated_solve(
+    c: &mut Criterion,
+    name: &str,
+    model: &dyn Mechanism,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut x = vec![0.0; n + mh + mnh];
+    c.bench_function(&format!("{name}/generated+solve"), |b| {
+        b.iter(|| {
+            let (forces, gamma) = x.split_at_mut(n);
+            let (gh, gnh) = gamma.split_at_mut(mh);
+            model.dynamics_terms(
+                black_box(t),
+                black_box(q),
+                black_box(qd),
+                DynamicsTerms {
+                    mass: &mut mass,
+                    forces,
+                    holonomic_jacobian: &mut cq,
+                    holonomic_gamma: gh,
+                    nonholonomic_matrix: &mut g,
+                    nonholonomic_gamma: gnh,
+                },
+            );
+            let outcome = model.augmented_solve(&mass, &cq, &g, &mut x);
+            assert_eq!(outcome, AugmentedSolve::Solved);
+            black_box(&x);
+        });
+    });
+}
+
 fn rhs(c: &mut Criterion) {
     for &(name, make, t, scale) in CASES {
         let model = make();
         let (q, qd) = moving_state(model.as_ref(), t);
         generated(c, name, model.as_ref(), t, &q, &qd);
+        generated_solve(c, name, model.as_ref(), t, &q, &qd);
         let n = q.len();
         for form in Formulation::ALL {
             let mut sys = StateSpace::new(model.as_ref(), form, 1e-8, 1e-8).expect("patterns");

@@ -49,6 +49,7 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
         best = best.min(start.elapsed().as_secs_f64() / args.calls as f64);
     }
     let path = match path {
+        SolverPath::Generated => "generated",
         SolverPath::Dense => "dense",
         SolverPath::Sparse => "sparse",
         SolverPath::Redundant => "redundant",

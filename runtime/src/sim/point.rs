@@ -312,7 +312,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.factorizations += 1;
         let stats = self
             .dynamics
-            .solve_evaluated(&mut self.ws, t, shift, &mut self.qdd, &mut self.lambda)
+            .solve_evaluated(
+                self.mech,
+                &mut self.ws,
+                t,
+                shift,
+                &mut self.qdd,
+                &mut self.lambda,
+            )
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.

@@ -17,5 +17,6 @@ mod redundant;
 mod robustness;
 mod sleigh;
 mod slider_crank;
+mod solve;
 mod stiff;
 mod units;

@@ -8,6 +8,7 @@
 mod contacts;
 mod data;
 pub mod expr;
+pub mod solve;
 
 use std::collections::HashSet;
 
@@ -375,6 +376,12 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         fns.extend(vector_fn(g, &names, "outputs", &roots, true));
     }
     fns.extend(dynamics_terms(g, &names, d));
+    fns.extend(solve::augmented_solve(
+        g,
+        model.coords.len(),
+        (d.c.len(), d.gb.len()),
+        (&d.mass, &d.cq, &d.gm),
+    ));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();
         roots.extend(qd0);
