@@ -19,7 +19,7 @@
 //!   DOPRI5 on the pendulum (three periods) and on `car_axis` (about twenty
 //!   oscillations of the wheels on their springs): the global error grows with the
 //!   span, measured up to 62 and 92 × rtol; bound 100. (Adams, measured: at most
-//!   2.9 × rtol, the pendulum with Baumgarte at 1e-5.)
+//!   2.7 × rtol, the pendulum with Baumgarte at 1e-11.)
 //! - RK4 has no tolerance (rtol only sets its step), so instead of a bound its error
 //!   per rtol must stay within a factor 20 over rtol ≤ 1e-5: proportional to the
 //!   tolerance-derived step's $h^4$.

@@ -25,10 +25,11 @@
 //! RMS norm of the Runge–Kutta methods. The estimate is that of the order-$k$ formula,
 //! while the order-$(k+1)$ corrected value is kept (local extrapolation), so the error
 //! actually committed is usually much smaller; math-spec §9.1 calls this test "error per
-//! unit step". There is no safety factor on acceptance. The step size aims at
-//! $\text{erk} = a = \varepsilon/32$ (`STEP` aims at $\tfrac12\varepsilon$): it grows by
-//! $\min\big(2, (a/\text{erk})^{1/(k+1)}\big)$ once $\text{erk} \le a/32$, is kept while
-//! $a/32 < \text{erk} \le a$, and shrinks by $(a/\text{erk})^{1/(k+1)}$ within
+//! unit step". There is no safety factor on acceptance. At order $k$ the step size
+//! aims at $\text{erk} = a = 0.8^{k+1}\,\tfrac12\varepsilon$ (`STEP` aims at
+//! $\tfrac12\varepsilon$), i.e. the new step is $0.8\,h\,(\tfrac12\varepsilon/\text{erk})^{1/(k+1)}$:
+//! it grows by $\min\big(2, (a/\text{erk})^{1/(k+1)}\big)$ once $\text{erk} \le a/32$, is
+//! kept while $a/32 < \text{erk} \le a$, and shrinks by $(a/\text{erk})^{1/(k+1)}$ within
 //! $[\tfrac12, 0.9]$ above $a$ (a departure from `STEP`, below). A tolerance below what
 //! round-off allows ($\tfrac12\varepsilon <
 //! 2u\|y\|$) is raised as `ode.f` does, see [`Adams::tolerance_scale`]. When the
@@ -50,8 +51,9 @@
 //! ranges over a factor 8192, so $h$ froze at whatever value the start phase or the last
 //! failure left and the tolerance no longer set the error (ARCHITECTURE.md, "Decision:
 //! the Adams step size follows the tolerance"). Here $h$ follows the tolerance within a
-//! factor 32 of erk, and the aim $\varepsilon/32$ makes the global error of the test
-//! problems at most about 3 × rtol at no cost at equal error.
+//! factor 32 of erk, and the safety factor 0.8 on $h$ (Hairer–Nørsett–Wanner I §II.4)
+//! keeps the global error of the test problems within about 3 × rtol at no cost at
+//! equal error.
 
 mod intrp;
 mod step;

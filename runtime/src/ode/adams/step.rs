@@ -24,9 +24,10 @@ const GSTR: [f64; 14] = [
     0.00524, 0.00468,
 ];
 
-/// The step size aims at $\text{erk} = \text{AIM}\cdot\tfrac12\varepsilon = \varepsilon/32$
-/// (`STEP`: $\tfrac12\varepsilon$); see the module docs of [`super`].
-const AIM: f64 = 1.0 / 16.0;
+/// Safety factor on the step size: at order $k$ the step size aims at
+/// $\text{erk} = \text{SAFETY}^{k+1}\,\tfrac12\varepsilon$ (`STEP`: $\tfrac12\varepsilon$),
+/// see the module docs of [`super`].
+const SAFETY: f64 = 0.8;
 
 /// The step size is kept while $\text{erk}$ lies within a factor `BAND` below the aim
 /// (`STEP`: $2^{k+1}$, so that only doubling is possible).
@@ -396,10 +397,11 @@ impl Adams {
         let h = self.h;
         let mut hnew = h + h;
         if !self.phase1 {
-            // The step size aims at erk = AIM·ε/2: it grows to that aim as soon as erk has
-            // fallen a factor BAND below it, and shrinks as soon as erk exceeds it.
-            let aim = AIM * p5eps;
+            // The step size aims at erk = SAFETY^(k+1)·ε/2: it grows to that aim as soon
+            // as erk has fallen a factor BAND below it, and shrinks as soon as erk
+            // exceeds it.
             let expo = 1.0 / (self.k + 1) as f64;
+            let aim = SAFETY.powi(self.k as i32 + 1) * p5eps;
             hnew = h;
             if erk * BAND <= aim {
                 // erk = 0 (a polynomial solution) doubles.
