@@ -29,6 +29,7 @@
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
 //! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
 //! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
+//! | [`flexible_pendulum`] | `e0 e1 e2 e3 p1 p2 p3 p4` | 1 holonomic (Euler-parameter normalization); a bar of spatial beam elements |
 //!
 //! ```
 //! use pfaff::Mechanism;
@@ -66,6 +67,8 @@ mod chain_models {
 }
 #[path = "flexible_crank.rs"]
 mod flexible_crank_model;
+#[path = "flexible_pendulum.rs"]
+mod flexible_pendulum_model;
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -106,6 +109,7 @@ pub use car_axis_model::car_axis;
 pub use chain_models::chain10;
 pub use falling_rod_model::falling_rod;
 pub use flexible_crank_model::{flexible_crank, flexible_crank_shapes};
+pub use flexible_pendulum_model::flexible_pendulum;
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
@@ -131,6 +135,10 @@ pub struct Entry {
     pub summary: &'static str,
     /// Builds the model with its default parameters.
     pub make: fn() -> Box<dyn pfaff::Mechanism>,
+    /// Stiff (elastic modes far above the motion's frequencies): the command simulates
+    /// it with Radau5 by default and sweeps only Radau5 in `work-precision`, whose
+    /// reference is a Radau5 run; explicit methods are held to their stability limit.
+    pub stiff: bool,
 }
 
 static ALL: &[Entry] = &[
@@ -138,127 +146,163 @@ static ALL: &[Entry] = &[
         name: "pendulum",
         summary: "simple pendulum in redundant Cartesian coordinates (IFToMM A01)",
         make: || Box::new(pendulum::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "slider_crank",
         summary: "planar slider-crank in absolute coordinates, driven crank (math-spec V10)",
         make: || Box::new(slider_crank::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "slider_crank_bodies",
         summary: "the slider-crank of `slider_crank` from bodies and joints",
         make: || Box::new(slider_crank_bodies::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "sleigh_bodies",
         summary: "the Chaplygin sleigh of `sleigh` from a body and a knife edge",
         make: || Box::new(sleigh_bodies::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "free_body",
         summary: "torque-free spatial rigid body with Euler parameters (math-spec V12)",
         make: || Box::new(free_body::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "rolling_disk",
         summary: "thin uniform disk rolling without slip on a plane",
         make: || Box::new(rolling_disk::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "bicycle",
         summary: "Whipple bicycle benchmark (Meijaard, Papadopoulos, Ruina, Schwab 2007)",
         make: || Box::new(bicycle::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "spatial_four_bar",
         summary: "spatial four-bar (revolute, spherical, universal) with Euler parameters",
         make: || Box::new(spatial_four_bar::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "bricard",
         summary: "Bricard's overconstrained 6R loop, rank-deficient everywhere (IFToMM A04)",
         make: || Box::new(bricard::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "andrews",
         summary: "Andrews' squeezing mechanism, seven bodies (Hairer & Wanner II §VII.7)",
         make: || Box::new(andrews::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "car_axis",
         summary: "car axle with rheonomic constraints (Rentrop, Roche, Steinebach 1989)",
         make: || Box::new(car_axis::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "sleigh",
         summary: "Chaplygin sleigh, non-holonomic knife edge (math-spec V11)",
         make: || Box::new(sleigh::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "seed2_example1",
         summary: "free motion with redundant coordinates, example 1 (math-spec §8.8, V2)",
         make: || Box::new(seed2_example1::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "seed2_example2",
         summary: "free motion with redundant coordinates, example 2 (math-spec §8.8, V4)",
         make: || Box::new(seed2_example2::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "parallelogram",
         summary: "parallelogram linkage with a redundant third crank (reactions of redundant constraints)",
         make: || Box::new(parallelogram::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "bouncing_ball",
         summary: "ball bouncing on the ground until the impacts accumulate, then resting",
         make: || Box::new(bouncing_ball::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "falling_rod",
         summary: "uniform rod falling at an angle onto a smooth floor (two end contacts)",
         make: || Box::new(falling_rod::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "pendulum_floor",
         summary: "double pendulum striking a floor, impulsive joint reactions (math-spec V15)",
         make: || Box::new(pendulum_floor::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "sleigh_wall",
         summary: "Chaplygin sleigh striking a wall, jump of the non-holonomic reaction (math-spec V16)",
         make: || Box::new(sleigh_wall::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "body_impact",
         summary: "free planar body striking a floor with a corner (math-spec V13)",
         make: || Box::new(body_impact::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "two_body_impact",
         summary: "two free planar bodies colliding, a disk and a rod (math-spec V14)",
         make: || Box::new(two_body_impact::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "newtons_cradle",
         summary: "Newton's cradle, three balls on strings (sequential impacts)",
         make: || Box::new(newtons_cradle::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "flexible_crank",
-        summary: "slider crank with an elastic rod in the floating frame (Simeon's test-set invariants); stiff: use radau5",
+        summary: "slider crank with an elastic rod in the floating frame (Simeon's test-set invariants)",
         make: || Box::new(flexible_crank::Model::default()),
+        stiff: true,
     },
     Entry {
         name: "flexible_crank_shapes",
         summary: "the flexible slider crank with the rod's invariants integrated from its shape functions",
         make: || Box::new(flexible_crank_shapes::Model::default()),
+        stiff: true,
     },
-
+    Entry {
+        name: "flexible_pendulum",
+        summary: "spatial flexible pendulum: a bar of 8 spatial beam elements, 4 modes, on a ball joint",
+        make: || Box::new(flexible_pendulum::Model::default()),
+        stiff: false,
+    },
+    Entry {
+        name: "spinup_beam",
+        summary: "spin-up of a cantilever beam, geometric stiffening switched by `stiffening` (Kane, Ryan & Banerjee 1987)",
+        make: || Box::new(spinup_beam::Model::default()),
+        stiff: true,
+    },
     Entry {
         name: "chain10",
         summary: "spatial chain of 10 rods on ball joints, Euler parameters (scaling, n = 70)",
         make: || Box::new(chain10::Model::default()),
+        stiff: false,
     },
 ];
 

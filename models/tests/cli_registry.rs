@@ -12,6 +12,10 @@ fn names() -> Vec<&'static str> {
     pfaff_models::all().iter().map(|e| e.name).collect()
 }
 
+fn stiff(name: &str) -> bool {
+    pfaff_models::find(name).is_some_and(|e| e.stiff)
+}
+
 #[test]
 fn every_model_simulates_and_linearizes_with_its_defaults() {
     for name in names() {
@@ -20,6 +24,9 @@ fn every_model_simulates_and_linearizes_with_its_defaults() {
         let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
         assert!(v.get("error").is_none(), "simulate {name}: {v}");
         assert!(v["final"]["t"].as_f64().is_some(), "simulate {name}: {v}");
+        // A stiff model runs with Radau5 unless told otherwise.
+        let method = if stiff(name) { "radau5" } else { "adams" };
+        assert_eq!(v["integrator"], method, "simulate {name}: {v}");
         // Every model has an operating point: its steady motion, or its initial state.
         let out = pfaff(&["linearize", name, "--json"]);
         assert!(out.status.success(), "linearize {name}: {}", stderr(&out));
@@ -62,20 +69,34 @@ fn every_model_runs_work_precision_with_its_defaults() {
             stderr(&out)
         );
         let text = stdout(&out);
+        // One row per tolerance of the sweep, 1e-3 to 1e-12; a stiff model sweeps
+        // Radau5 alone, 1e-3 to 1e-9, and every row of it finishes.
+        let (methods, sweep): (&[&str], usize) = if stiff(name) {
+            (&["radau5"], 7)
+        } else {
+            (&["rk4", "dopri5", "dop853", "adams", "radau5"], 10)
+        };
         for formulation in ["partitioning", "projection", "baumgarte"] {
-            for method in ["rk4", "dopri5", "dop853", "adams"] {
-                // One row per tolerance of the sweep, 1e-3 to 1e-12.
-                let rows = text
+            for method in ["rk4", "dopri5", "dop853", "adams", "radau5"] {
+                let rows: Vec<&str> = text
                     .lines()
                     .filter(|l| {
                         let mut cols = l.split_whitespace();
                         cols.next() == Some(formulation) && cols.next() == Some(method)
                     })
-                    .count();
+                    .collect();
+                let want = if methods.contains(&method) { sweep } else { 0 };
                 assert_eq!(
-                    rows, 10,
+                    rows.len(),
+                    want,
                     "work-precision {name}, {formulation} {method}:\n{text}"
                 );
+                if stiff(name) {
+                    assert!(
+                        rows.iter().all(|r| !r.contains("FAILED")),
+                        "work-precision {name}, {formulation} {method}:\n{text}"
+                    );
+                }
             }
         }
     }

@@ -43,7 +43,7 @@ mod clamped_beam {
     }
 }
 
-fn reference_beam(ei: f64) -> Invariants {
+fn reference_beam(ei: f64) -> Beam {
     Beam {
         dim: Dim::Planar,
         elements: 8,
@@ -52,8 +52,16 @@ fn reference_beam(ei: f64) -> Invariants {
         reference: Reference::Clamped { node: 0 },
         reduction: Reduction::Modes(2),
     }
-    .invariants()
-    .unwrap()
+}
+
+/// The slot of a beam: `Beam::write_slot`'s layout, the invariants first.
+fn slot(beam: &Beam) -> Vec<f64> {
+    let mut out = vec![0.0; beam.slot_len()];
+    beam.write_slot(&mut out).unwrap();
+    let mut flat = vec![0.0; Invariants::flat_len(beam.dim.d(), beam.coordinates())];
+    beam.invariants().unwrap().write_flat(&mut flat).unwrap();
+    assert_eq!(&out[..flat.len()], &flat[..]);
+    out
 }
 
 #[test]
@@ -61,12 +69,15 @@ fn beam_slot_is_filled_from_the_parameters() {
     let mut model = clamped_beam::Model::default();
     let info = model.info();
     assert_eq!(info.data.len(), 2);
-    assert_eq!((info.data[0].name, info.data[0].len), ("rod", 43));
+    // 43 invariants, length and EA, T (27 nodal coordinates × 2), K_Ω (2 × 2).
+    assert_eq!(
+        (info.data[0].name, info.data[0].len),
+        ("rod", 43 + 2 + 54 + 4)
+    );
     assert_eq!(Invariants::flat_len(2, 2), 43);
+    assert_eq!(reference_beam(1.4e4).slot_len(), 103);
     assert_eq!((info.data[1].name, info.data[1].len), ("fe", 3));
-    let mut want = vec![0.0; 43];
-    reference_beam(1.4e4).write_flat(&mut want).unwrap();
-    assert_eq!(model.data(0), &want[..]);
+    assert_eq!(model.data(0), &slot(&reference_beam(1.4e4))[..]);
     assert_eq!(model.data(1), &[0.0; 3]);
     // The generated mass matrix is the modal one (identity), the forces −K p with
     // K = diag(ω1², ω2²), ω1 = 3.7977 rad/s (benchmark-models.md).
@@ -82,8 +93,7 @@ fn beam_slot_is_filled_from_the_parameters() {
     assert!(f[1].abs() < 1e-9 * -f[0]);
     // A parameter change recomputes the slot: ω² scales with EI.
     model.set_parameter(2, 2.8e4);
-    reference_beam(2.8e4).write_flat(&mut want).unwrap();
-    assert_eq!(model.data(0), &want[..]);
+    assert_eq!(model.data(0), &slot(&reference_beam(2.8e4))[..]);
     let mut f2 = [0.0; 2];
     model.forces(0.0, &[1.0, 0.0], &[0.0, 0.0], &mut f2);
     assert!((f2[0] / f[0] - 2.0).abs() < 1e-12);
@@ -193,10 +203,9 @@ fn spatial_craig_bampton_and_simply_supported_slots() {
         reference: Reference::SimplySupported { first: 0, last: 6 },
         reduction: Reduction::Modes(3),
     };
-    for (k, beam, d, n) in [(0, arm, 3, 8), (1, span, 2, 3)] {
+    for (k, beam, n) in [(0, arm, 8), (1, span, 3)] {
         assert_eq!(beam.coordinates(), n);
-        let mut want = vec![0.0; Invariants::flat_len(d, n)];
-        beam.invariants().unwrap().write_flat(&mut want).unwrap();
+        let want = slot(&beam);
         assert_eq!(model.info().data[k].len as usize, want.len());
         assert_eq!(model.data(k), &want[..]);
     }

@@ -142,9 +142,9 @@ pub struct SimulateArgs {
     /// How the constraints are handled.
     #[arg(long, value_enum, value_name = "F", default_value_t = FormulationArg::Partitioning)]
     pub formulation: FormulationArg,
-    /// The integrator.
-    #[arg(long, value_enum, value_name = "I", default_value_t = IntegratorArg::Adams)]
-    pub integrator: IntegratorArg,
+    /// The integrator (default: adams, radau5 for the models `pfaff list` marks stiff).
+    #[arg(long, value_enum, value_name = "I")]
+    pub integrator: Option<IntegratorArg>,
     /// Relative tolerance of the adaptive integrators.
     #[arg(
         long,
@@ -221,6 +221,10 @@ pub struct WorkPrecisionArgs {
     /// method.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// On a stiff model, sweep the explicit methods too (held to their stability limit,
+    /// they may take very long or fail); other models always sweep every method.
+    #[arg(long)]
+    pub all_methods: bool,
 }
 
 /// Arguments of `pfaff rhs-time`.

@@ -33,12 +33,16 @@ pub fn list() -> String {
                 .collect::<String>(),
             info.bodies.len(),
             info.joints.len(),
-            e.summary
+            if e.stiff {
+                format!("{} [stiff]", e.summary)
+            } else {
+                e.summary.to_owned()
+            }
         );
     }
     let _ = writeln!(
         w,
-        "\nnq coordinates, hol holonomic and nhol non-holonomic constraints; t_end the default span [s] of `pfaff simulate`;\nbodies and joints of the models written at the body level"
+        "\nnq coordinates, hol holonomic and nhol non-holonomic constraints; t_end the default span [s] of `pfaff simulate`;\nbodies and joints of the models written at the body level;\n[stiff]: simulated with radau5 by default, work-precision sweeps radau5 only"
     );
     w
 }
@@ -105,6 +109,12 @@ pub fn show(name: &str) -> Result<String, CliError> {
     }
     let scene = Scene::of(info.name);
     let _ = writeln!(w, "default span: 0 to {} s ({})", scene.t_end, scene.span);
+    if entry.stiff {
+        let _ = writeln!(
+            w,
+            "stiff: `simulate` uses radau5 unless --integrator says otherwise; `work-precision` sweeps radau5 (--all-methods: every method)"
+        );
+    }
     if let Some(s) = scene.steady {
         let _ = writeln!(
             w,

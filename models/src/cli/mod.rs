@@ -31,7 +31,7 @@ fn default_scene() -> SimulateArgs {
         model: "andrews".to_owned(),
         t_end: None,
         formulation: FormulationArg::Partitioning,
-        integrator: IntegratorArg::Adams,
+        integrator: Some(IntegratorArg::Adams),
         rtol: 1e-6,
         atol: 1e-8,
         step: None,

@@ -1,6 +1,9 @@
 //! `pfaff work-precision`: every formulation × integrator over a tolerance sweep, by
 //! [`pfaff::sim::work_precision`], against a closed form where the model has one and
-//! otherwise against a run at rtol 1e-13 with partitioning and DOP853.
+//! otherwise against a run at rtol 1e-13 with partitioning and DOP853. A stiff model
+//! (`Entry::stiff`) sweeps Radau5 over rtol 1e-3 … 1e-9 against a Radau5 run at rtol
+//! 1e-12 (the explicit methods, held to their stability limit, only with
+//! `--all-methods`).
 
 use pfaff::sim::{format_table, work_precision, Formulation, Method, Reference, Simulation, Sweep};
 
@@ -40,10 +43,15 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             (r, "the closed-form solution".to_owned())
         }
         None => {
+            let (method, rtol, atol) = if entry.stiff {
+                (Method::Radau5, 1e-12, 1e-14)
+            } else {
+                (Method::Dop853, 1e-13, 1e-15)
+            };
             let run = Simulation::new(model.as_ref())
                 .formulation(Formulation::Partitioning)
-                .integrator(Method::Dop853)
-                .tolerances(1e-13, 1e-15)
+                .integrator(method)
+                .tolerances(rtol, atol)
                 .output_times(&[])
                 .run(t_end)
                 .map_err(|e| {
@@ -54,15 +62,28 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
                 })?;
             (
                 Reference::from_run(&run),
-                "a run at rtol 1e-13, atol 1e-15 (partitioning + dop853)".to_owned(),
+                format!(
+                    "a run at rtol {rtol:e}, atol {atol:e} (partitioning + {})",
+                    method.name()
+                ),
             )
         }
     };
-    let rows = work_precision(model.as_ref(), &Sweep::standard(t_end), &reference);
+    let mut sweep = Sweep::standard(t_end);
+    if entry.stiff && !args.all_methods {
+        sweep.methods = vec![Method::Radau5];
+        sweep.rtols = (3..=9).map(|k| 10f64.powi(-k)).collect();
+    }
+    let rows = work_precision(model.as_ref(), &sweep, &reference);
     println!(
         "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference|, reference: {source}",
         entry.name
     );
+    if entry.stiff && !args.all_methods {
+        println!(
+            "stiff model: radau5 only (the explicit methods are held to their stability limit; --all-methods sweeps them too)"
+        );
+    }
     if !reference.impacts.is_empty() {
         println!(
             "t_impact = largest |impact time - closed form| over the {} impacts of the span [s]",

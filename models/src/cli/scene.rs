@@ -110,6 +110,21 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
+            "flexible_pendulum" => Self {
+                // About three swings: 2π/√(3g/2l) = 1.64 s for the rigid bar.
+                t_end: 5.0,
+                span: "about three swings",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
+            "spinup_beam" => Self {
+                t_end: 20.0,
+                span: "the benchmark's span: spin-up over 15 s, then 5 s at constant rate",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
             "andrews" => Self {
                 t_end: 0.03,
                 span: "the reference span of Hairer & Wanner",

@@ -51,7 +51,12 @@ fn positive(flag: &str, v: f64, allow_zero: bool) -> Result<(), CliError> {
 }
 
 /// Checks the numbers of `args` and picks the defaults.
-pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>, CliError> {
+/// A stiff model (`Entry::stiff`) defaults to Radau5, the others to Adams.
+pub fn request<'a>(
+    args: &'a SimulateArgs,
+    scene: &Scene,
+    stiff: bool,
+) -> Result<Request<'a>, CliError> {
     positive("--rtol", args.rtol, false)?;
     if args.rtol > 1.0 {
         return Err(usage(format!(
@@ -86,7 +91,12 @@ pub fn request<'a>(args: &'a SimulateArgs, scene: &Scene) -> Result<Request<'a>,
     if args.repeat == 0 {
         return Err(usage("invalid --repeat 0: expected at least 1"));
     }
-    let method = match args.integrator {
+    let default = if stiff {
+        IntegratorArg::Radau5
+    } else {
+        IntegratorArg::Adams
+    };
+    let method = match args.integrator.unwrap_or(default) {
         IntegratorArg::Rk4 => Method::Rk4 {
             h: step.unwrap_or(if t_end > 0.0 { t_end / 1000.0 } else { 1e-3 }),
         },
@@ -580,7 +590,7 @@ pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
     let entry = setup::find_model(&args.model)?;
     let model = setup::build(entry, &args.state.set)?;
     let scene = Scene::of(entry.name);
-    let req = request(args, &scene)?;
+    let req = request(args, &scene, entry.stiff)?;
     let dense = args.csv.is_some() || args.plot.is_some() || args.animate.is_some();
     let out = run(model.as_ref(), &req, dense)?;
     report(model.as_ref(), &req, &scene, &out)

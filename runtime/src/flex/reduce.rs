@@ -320,6 +320,10 @@ pub enum Reduction {
     None,
     /// Keep the lowest `n` modes (E21).
     Modes(usize),
+    /// Keep the modes of these indices in ascending order of frequency (0 the lowest;
+    /// [`Constrained::mode_set`]): the lowest bending modes and the first axial one of a
+    /// spinning beam, whose centrifugal load only axial modes carry.
+    ModeSet(Vec<usize>),
     /// Craig–Bampton (E22): the coordinates of the boundary nodes and `modes`
     /// fixed-interface modes.
     CraigBampton {
@@ -367,6 +371,7 @@ impl Beam {
         match &self.reduction {
             Reduction::None => Ok(constrained.unreduced()),
             Reduction::Modes(n) => constrained.modes(*n),
+            Reduction::ModeSet(set) => constrained.mode_set(set),
             Reduction::CraigBampton { boundary, modes } => {
                 constrained.craig_bampton(boundary, *modes)
             }
@@ -381,12 +386,125 @@ impl Beam {
         Ok(self.reduce()?.invariants)
     }
 
+    /// The length of a beam's data slot: [`Invariants::flat_len`], then the length and
+    /// axial stiffness, the basis $T$ (`ndof × n`) and the centrifugal geometric
+    /// stiffness $K_\Omega$ (`n × n`).
+    #[must_use]
+    pub fn slot_len(&self) -> usize {
+        let n = self.coordinates();
+        let ndof = (self.elements + 1) * self.dim.dofs_per_node();
+        Invariants::flat_len(self.dim.d(), n) + 2 + ndof * n + n * n
+    }
+
+    /// Writes the layout of a model's beam data slot into `out`:
+    /// `[invariants (Invariants::write_flat), length, EA, T, K_Ω]`, `T` the reduced basis
+    /// row-major `ndof × n` (nodal coordinates in the body frame × elastic coordinates;
+    /// the rows of the coordinates the reference condition deletes are zero) and `K_Ω`
+    /// the reduced geometric stiffness of a unit spin ([`Beam::spin_stiffness`]). The
+    /// generated code reads the nodes' displacements (`body.node(k)`) from `T` and the
+    /// geometric stiffening of a spinning beam from `K_Ω`.
+    ///
+    /// # Errors
+    /// As [`Beam::reduce`], or [`FlexError::Layout`] when `out` does not have
+    /// [`Beam::slot_len`] values.
+    pub fn write_slot(&self, out: &mut [f64]) -> Result<(), FlexError> {
+        let reduced = self.reduce()?;
+        let inv = &reduced.invariants;
+        let n = inv.n;
+        let flat = Invariants::flat_len(inv.d, n);
+        let want = flat + 2 + reduced.basis.len() + n * n;
+        if out.len() != want {
+            return Err(FlexError::Layout {
+                d: inv.d,
+                n,
+                expected: want,
+                got: out.len(),
+            });
+        }
+        let (head, tail) = out.split_at_mut(flat);
+        inv.write_flat(head)?;
+        tail[0] = self.length;
+        tail[1] = self.section.ea;
+        let (basis, k_spin) = tail[2..].split_at_mut(reduced.basis.len());
+        basis.copy_from_slice(&reduced.basis);
+        k_spin.copy_from_slice(&self.spin_stiffness(&reduced.basis, n));
+        Ok(())
+    }
+
+    /// The geometric stiffness of the beam spinning at unit rate about an axis through
+    /// its root (node 0, the body origin) perpendicular to it, on the reduced
+    /// coordinates of the basis `t` (`ndof × n`, row-major):
+    /// $K_\Omega = \int_0^l P(x)\,(N_v'^\mathsf{T}N_v' + N_w'^\mathsf{T}N_w')\,dx$ with
+    /// the centrifugal axial force $P(x) = \rho A\,(l^2 - x^2)/2$ and $N_v'$, $N_w'$ the
+    /// slopes of the lateral deflections (the Hermite cubics of E18/E20, $\vartheta_z = v'$,
+    /// $\vartheta_y = -w'$). A body spinning at $\bar\omega$ feels
+    /// $-(\bar\omega_y^2 + \bar\omega_z^2)K_\Omega q_f$ (planar: $-\dot\theta^2 K_\Omega q_f$):
+    /// the stress stiffening of the centrifugal tension, which the linear floating frame
+    /// lacks (math-spec §3.6). The integrand has degree 6 along an element: 5-point
+    /// Gauss–Legendre is exact.
+    #[must_use]
+    pub fn spin_stiffness(&self, t: &[f64], n: usize) -> Vec<f64> {
+        const X: [f64; 5] = [
+            -0.906_179_845_938_664,
+            -0.538_469_310_105_683_1,
+            0.0,
+            0.538_469_310_105_683_1,
+            0.906_179_845_938_664,
+        ];
+        const W: [f64; 5] = [
+            0.236_926_885_056_189_1,
+            0.478_628_670_499_366_5,
+            0.568_888_888_888_888_9,
+            0.478_628_670_499_366_5,
+            0.236_926_885_056_189_1,
+        ];
+        let dpn = self.dim.dofs_per_node();
+        // (deflection, slope, sign of the slope coordinate) per lateral direction.
+        let lateral: &[(usize, usize, f64)] = match self.dim {
+            Dim::Planar => &[(1, 2, 1.0)],
+            Dim::Spatial => &[(1, 5, 1.0), (2, 4, -1.0)],
+        };
+        let (l, ne) = (self.length, self.elements as f64);
+        let h = l / ne;
+        let mut k = vec![0.0; n * n];
+        let mut slope = vec![0.0; n];
+        for e in 0..self.elements {
+            let (a, b) = (e * dpn, (e + 1) * dpn);
+            for (x, w) in X.iter().zip(W) {
+                let s = 0.5 * (1.0 + x);
+                let xe = (e as f64 + s) * h;
+                let p = 0.5 * self.section.rho_a * (l * l - xe * xe);
+                let c = [
+                    (-6.0 * s + 6.0 * s * s) / h,
+                    1.0 - 4.0 * s + 3.0 * s * s,
+                    (6.0 * s - 6.0 * s * s) / h,
+                    3.0 * s * s - 2.0 * s,
+                ];
+                for &(v, th, sign) in lateral {
+                    let rows = [a + v, a + th, b + v, b + th];
+                    let signs = [1.0, sign, 1.0, sign];
+                    for (j, sl) in slope.iter_mut().enumerate() {
+                        *sl = (0..4).map(|i| c[i] * signs[i] * t[rows[i] * n + j]).sum();
+                    }
+                    let f = 0.5 * w * h * p;
+                    for i in 0..n {
+                        for j in 0..n {
+                            k[i * n + j] += f * slope[i] * slope[j];
+                        }
+                    }
+                }
+            }
+        }
+        k
+    }
+
     /// The number of elastic coordinates after reduction (without computing them).
     #[must_use]
     pub fn coordinates(&self) -> usize {
         let dpn = self.dim.dofs_per_node();
         match &self.reduction {
             Reduction::Modes(n) => *n,
+            Reduction::ModeSet(set) => set.len(),
             Reduction::None => {
                 let mesh = self.mesh();
                 mesh.ndof() - self.reference.deleted(&mesh).map_or(0, |d| d.len())

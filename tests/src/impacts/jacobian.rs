@@ -106,11 +106,13 @@ fn contact_jacobians_match_finite_differences() {
         name: "moving_floor",
         summary: "",
         make: || Box::new(moving_floor::Model::default()),
+        stiff: false,
     };
     let surfaces = pfaff_models::Entry {
         name: "surfaces",
         summary: "",
         make: || Box::new(surfaces::Model::default()),
+        stiff: false,
     };
     for entry in pfaff_models::all().iter().chain([&extra, &surfaces]) {
         let model = (entry.make)();

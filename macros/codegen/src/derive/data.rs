@@ -95,6 +95,24 @@ pub struct SlotLeaves {
     pub m_ff: Vec<ExprId>,
     /// `K_ff` (n × n).
     pub k_ff: Vec<ExprId>,
+    /// What a beam slot holds besides the invariants; `None` for a slot set by the
+    /// program.
+    pub beam: Option<BeamLeaves>,
+}
+
+/// The nodes and elements of a beam slot: its length, axial stiffness and reduced basis.
+#[derive(Clone, Debug)]
+pub struct BeamLeaves {
+    pub elements: usize,
+    /// Nodal coordinates per node (3: `u v θ`, 6: `u_x u_y u_z θ_x θ_y θ_z`).
+    pub dofs_per_node: usize,
+    pub length: ExprId,
+    pub ea: ExprId,
+    /// `T` (ndof × n): nodal coordinates in the body frame from the elastic ones.
+    pub basis: Vec<ExprId>,
+    /// `K_Ω` (n × n): the geometric stiffness of a unit spin about an axis through the
+    /// root perpendicular to the beam (`pfaff::flex::Beam::spin_stiffness`).
+    pub k_spin: Vec<ExprId>,
 }
 
 /// The invariants of a deformable body of `d` axes and `n` elastic coordinates read from
@@ -173,7 +191,20 @@ pub fn slot_leaves(
     let s_kl = take(g, d * d * n * n);
     let m_ff = take(g, n * n);
     let k_ff = take(g, n * n);
+    let beam = slot.beam.as_ref().map(|b| {
+        let length = take(g, 1)[0];
+        let ea = take(g, 1)[0];
+        BeamLeaves {
+            elements: b.elements,
+            dofs_per_node: b.dofs_per_node(),
+            length,
+            ea,
+            basis: take(g, b.ndof() * n),
+            k_spin: take(g, n * n),
+        }
+    });
     Some(SlotLeaves {
+        beam,
         m,
         i1,
         s_bar,

@@ -83,7 +83,10 @@ pub fn data(g: &Graph, names: &ModelNames, model: &Model, d: &Derived) -> Option
             }
         };
         let modes = Literal::usize_unsuffixed(beam.modes);
-        let reduction = if beam.boundary.is_empty() {
+        let reduction = if let Some(set) = &beam.mode_set {
+            let set = set.iter().map(|&x| Literal::usize_unsuffixed(x));
+            quote!(#flex::Reduction::ModeSet(::std::vec![#(#set),*]))
+        } else if beam.boundary.is_empty() {
             quote!(#flex::Reduction::Modes(#modes))
         } else {
             let b = beam.boundary.iter().map(|&x| Literal::usize_unsuffixed(x));
@@ -103,9 +106,7 @@ pub fn data(g: &Graph, names: &ModelNames, model: &Model, d: &Derived) -> Option
                     reference: #reference,
                     reduction: #reduction,
                 };
-                if let ::core::result::Result::Err(e) =
-                    beam.invariants().and_then(|inv| inv.write_flat(&mut self.data.#field))
-                {
+                if let ::core::result::Result::Err(e) = beam.write_slot(&mut self.data.#field) {
                     self.data.#field.fill(f64::NAN);
                     if result.is_ok() {
                         result = ::core::result::Result::Err(e);

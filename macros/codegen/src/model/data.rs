@@ -14,9 +14,13 @@
 //! fix its layout (elements, reference, modes, boundary nodes) and the parameter
 //! expressions of its geometry and section, translated later. A beam slot holds the
 //! reduced body's invariants in the flat layout of `pfaff::flex::Invariants::write_flat`
-//! (`[m, Ī1, S̄, I_kl, Ī_kl, S̄_kl, M_ff, K_ff]`), so its length is
-//! `1 + d + dn + d² + d²n + d²n² + 2n²` for `d` axes and `n` elastic coordinates, both
-//! known here. Expressions read a slot's entries as `name[i]` (`Var::Data`).
+//! (`[m, Ī1, S̄, I_kl, Ī_kl, S̄_kl, M_ff, K_ff]`, `1 + d + dn + d² + d²n + d²n² + 2n²`
+//! values for `d` axes and `n` elastic coordinates), then the beam's length and axial
+//! stiffness, its reduced basis `T` (`ndof × n`, `ndof` the nodal coordinates) and the
+//! geometric stiffness of a unit spin `K_Ω` (`n × n`), the layout of
+//! `pfaff::flex::Beam::write_slot`; all sizes are known here. `modes: N` keeps
+//! the lowest `N` modes, `modes: [0, 1, 2, 3, 8]` those of the listed indices.
+//! Expressions read a slot's entries as `name[i]` (`Var::Data`).
 
 use std::collections::BTreeSet;
 
@@ -52,6 +56,8 @@ pub struct BeamDecl {
     pub reference: BeamReference,
     /// Fixed-interface modes (Craig–Bampton) or modes kept (no boundary).
     pub modes: usize,
+    /// The indices of the modes kept (`modes: [..]`), in ascending order of frequency.
+    pub mode_set: Option<Vec<usize>>,
     /// Craig–Bampton boundary nodes (empty: modal reduction).
     pub boundary: Vec<usize>,
     pub length: syn::Expr,
@@ -60,6 +66,27 @@ pub struct BeamDecl {
     /// Body-frame axes (2, 3) and elastic coordinates of the reduced body.
     pub d: usize,
     pub n: usize,
+}
+
+impl BeamDecl {
+    /// Nodal coordinates per node (3 planar, 6 spatial).
+    pub fn dofs_per_node(&self) -> usize {
+        if self.spatial {
+            6
+        } else {
+            3
+        }
+    }
+
+    /// The number of nodal coordinates, the rows of the basis `T`.
+    pub fn ndof(&self) -> usize {
+        (self.elements + 1) * self.dofs_per_node()
+    }
+
+    /// Where the length, `EA` and `T` start in the slot.
+    pub fn tail(&self) -> usize {
+        flat_len(self.d, self.n)
+    }
 }
 
 const PLANAR_SECTION: &[&str] = &["rho_a", "ea", "ei"];
@@ -203,7 +230,28 @@ pub fn lower(
         cx.error_spanned_by(get("elements")?, "a beam has at least one element");
         return None;
     }
-    let modes = integer(cx, get("modes")?, "the number of modes")?;
+    let (modes, mode_set) = match get("modes")? {
+        syn::Expr::Array(a) => {
+            let mut set = Vec::new();
+            for x in &a.elems {
+                let k = integer(cx, x, "a mode index")?;
+                if set.contains(&k) {
+                    cx.error_spanned_by(x, format!("mode {k} is listed twice"));
+                    return None;
+                }
+                set.push(k);
+            }
+            (set.len(), Some(set))
+        }
+        e => (integer(cx, e, "the number of modes")?, None),
+    };
+    if mode_set.is_some() && get("boundary").is_some() {
+        cx.error_spanned_by(
+            get("modes")?,
+            "a list of modes is a modal reduction; with `boundary` (Craig–Bampton) give their number",
+        );
+        return None;
+    }
     let reference = match get("reference") {
         Some(r) => reference(cx, r, elements)?,
         None => BeamReference::Clamped(0),
@@ -237,6 +285,13 @@ pub fn lower(
         nb += kept;
     }
     let interior = (elements + 1) * dpn - deleted.len() - nb;
+    if let Some(bad) = mode_set.iter().flatten().find(|&&k| k >= interior) {
+        cx.error_spanned_by(
+            get("modes")?,
+            format!("mode {bad} does not exist: the beam has {interior} modes, 0..{interior}"),
+        );
+        return None;
+    }
     if modes > interior || (modes == 0 && boundary.is_empty()) {
         cx.error_spanned_by(
             get("modes")?,
@@ -257,22 +312,24 @@ pub fn lower(
         .iter()
         .map(|f| get(f).cloned())
         .collect::<Option<_>>()?;
+    let beam = BeamDecl {
+        spatial,
+        elements,
+        reference,
+        modes,
+        mode_set,
+        boundary,
+        length: get("length")?.clone(),
+        section,
+        d,
+        n,
+    };
     Some(DataDecl {
         name,
         docs,
         offset,
-        len: flat_len(d, n),
-        beam: Some(BeamDecl {
-            spatial,
-            elements,
-            reference,
-            modes,
-            boundary,
-            length: get("length")?.clone(),
-            section,
-            d,
-            n,
-        }),
+        len: flat_len(d, n) + 2 + beam.ndof() * n + n * n,
+        beam: Some(beam),
     })
 }
 

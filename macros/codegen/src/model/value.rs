@@ -17,7 +17,7 @@
 use quote::ToTokens;
 
 use super::expr::Translator;
-use crate::sym::{diff, ExprId, Graph};
+use crate::sym::{diff, ExprId, Graph, Var};
 
 /// The value of an expression.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,6 +72,41 @@ pub struct Material {
     pub dim: usize,
     pub position: Option<Closure>,
     pub displacement: Option<Closure>,
+    /// A body built from beam elements (`data: beam_slot`): its nodes.
+    pub nodes: Option<Nodes>,
+}
+
+/// The nodes of a beam-element body: node `k` is at `x_k = k l / elements` on the
+/// frame's x axis and moves by the translational rows of the basis `T` times `q_f`.
+#[derive(Clone, Debug)]
+pub struct Nodes {
+    pub elements: usize,
+    pub dofs_per_node: usize,
+    /// The beam's length (a data leaf).
+    pub length: ExprId,
+    /// `T` (ndof × n), data leaves.
+    pub basis: Vec<ExprId>,
+    /// The elastic coordinates.
+    pub qf: Vec<u32>,
+}
+
+impl Nodes {
+    /// Node `k`'s deformed position in the body's frame (`dim` components).
+    pub fn at(&self, g: &mut Graph, dim: usize, k: usize) -> Vec<ExprId> {
+        let n = self.qf.len();
+        let frac = g.constant(k as f64 / self.elements as f64);
+        let x = g.mul(vec![frac, self.length]);
+        let z = g.constant(0.0);
+        let q: Vec<ExprId> = self.qf.iter().map(|&i| g.var(Var::Q(i))).collect();
+        (0..dim)
+            .map(|c| {
+                let row = &self.basis[(k * self.dofs_per_node + c) * n..][..n];
+                let u = dot(g, row, &q);
+                let x0 = if c == 0 { x } else { z };
+                g.add(vec![x0, u])
+            })
+            .collect()
+    }
 }
 
 impl Material {
@@ -85,7 +120,11 @@ impl Material {
         let Some(p) = &self.position else {
             tr.cx.error_spanned_by(
                 at,
-                "this deformable body declares no `position: |xi| [..]`, so its material points are unknown",
+                if self.nodes.is_some() {
+                    "a body built from beam elements has no material closure: take its nodes, `body.node(k)`"
+                } else {
+                    "this deformable body declares no `position: |xi| [..]`, so its material points are unknown"
+                },
             );
             return None;
         };
@@ -320,6 +359,7 @@ const FRAME_METHODS: &[&str] = &[
     "angular_velocity",
     "angle",
     "material",
+    "node",
 ];
 const MATRIX_FUNCTIONS: &[&str] = &[
     "rot2",
@@ -820,7 +860,10 @@ impl Translator<'_> {
     ) -> Option<Value> {
         let dim = f.map_or_else(|| self.model_dim(), |k| self.frames[k].dim);
         let fv = self.frame_value(f, dim);
-        let want = usize::from(matches!(name, "point" | "axis" | "velocity" | "material"));
+        let want = usize::from(matches!(
+            name,
+            "point" | "axis" | "velocity" | "material" | "node"
+        ));
         if m.args.len() != want {
             self.cx.error_spanned_by(
                 m,
@@ -883,6 +926,43 @@ impl Translator<'_> {
                 };
                 let xi = self.expr(&m.args[0])?;
                 Value::Vector(material.at(self, &m.args[0], xi)?)
+            }
+            "node" => {
+                let nodes = f.and_then(|k| {
+                    self.materials
+                        .iter()
+                        .find(|(i, _)| *i == k)
+                        .and_then(|(_, m)| m.nodes.clone())
+                });
+                let Some(nodes) = nodes else {
+                    self.cx.error_spanned_by(
+                        &m.method,
+                        "`node` applies to deformable bodies built from beam elements (`Deformable { data: beam, .. }`)",
+                    );
+                    return None;
+                };
+                let mut arg = &m.args[0];
+                while let syn::Expr::Group(g) = arg {
+                    arg = &g.expr;
+                }
+                let k = match arg {
+                    syn::Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Int(i),
+                        ..
+                    }) => i.base10_parse::<usize>().ok(),
+                    _ => None,
+                };
+                let Some(k) = k.filter(|&k| k <= nodes.elements) else {
+                    self.cx.error_spanned_by(
+                        &m.args[0],
+                        format!(
+                            "a node is an integer literal from 0 to {} (the beam's nodes)",
+                            nodes.elements
+                        ),
+                    );
+                    return None;
+                };
+                Value::Vector(nodes.at(self.g, dim, k))
             }
             _ => unreachable!("frame methods are listed"),
         })
