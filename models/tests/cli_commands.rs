@@ -481,7 +481,7 @@ fn progress_bar_stays_hidden_when_stderr_is_not_a_terminal() {
         "simulate",
         "pendulum",
         "--t-end",
-        "2000",
+        "6000",
         "--integrator",
         "dop853",
         "--rtol",

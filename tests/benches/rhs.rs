@@ -11,7 +11,9 @@
 //!   state off the constraint manifold by a predictor's error (an Euler step of 1e-3
 //!   of the motion's time scale from a consistent state), alternating between two such
 //!   states so that nothing is reused from the previous call; partitioning does its
-//!   usual Newton update there.
+//!   usual Newton update there. Each with the generated solve of the augmented system
+//!   (`Auto`), and with the general path it replaces (`…/general`: the dense $LU$
+//!   below the crossover, the sparse one from it), side by side in one run.
 //!
 //! Models: `pendulum`, `andrews` and `chain10` (the spatial chain of 10 rods on ball
 //! joints, Euler parameters: n = 70, 40 constraints). Another model is one entry of
@@ -25,7 +27,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use pfaff::ode::OdeSystem;
 use pfaff::sim::{Formulation, Method, Simulation, StateSpace};
-use pfaff::{AugmentedSolve, DynamicsTerms, Mechanism};
+use pfaff::{AugmentedSolve, DynamicsTerms, LinearSolver, Mechanism, DEFAULT_CROSSOVER};
 
 /// A model, and the time after which its state is moving (taken by a tight run from
 /// its initial state) and its motion's time scale.
@@ -142,8 +144,22 @@ fn rhs(c: &mut Criterion) {
         generated(c, name, model.as_ref(), t, &q, &qd);
         generated_solve(c, name, model.as_ref(), t, &q, &qd);
         let n = q.len();
-        for form in Formulation::ALL {
-            let mut sys = StateSpace::new(model.as_ref(), form, 1e-8, 1e-8).expect("patterns");
+        // The general path as before the generated solve: dense LU below the
+        // crossover, sparse LU from it.
+        let dim = n + model.info().nh() + model.info().nnh();
+        let general = if dim < DEFAULT_CROSSOVER {
+            LinearSolver::Dense
+        } else {
+            LinearSolver::Sparse
+        };
+        for (form, solver) in Formulation::ALL
+            .into_iter()
+            .flat_map(|f| [(f, LinearSolver::Auto), (f, general)])
+        {
+            let mut sys = StateSpace::new(model.as_ref(), form, 1e-8, 1e-8)
+                .expect("patterns")
+                .linear_solver(solver)
+                .expect("the solver");
             sys.start(t, &q, &qd).expect("a consistent state");
             let mut y0 = q.clone();
             y0.extend_from_slice(&qd);
@@ -156,7 +172,12 @@ fn rhs(c: &mut Criterion) {
                 .collect();
             let mut dy = vec![0.0; 2 * n];
             let mut k = 0;
-            c.bench_function(&format!("{name}/{}", form.name()), |b| {
+            let label = if solver == LinearSolver::Auto {
+                form.name().to_owned()
+            } else {
+                format!("{}/general", form.name())
+            };
+            c.bench_function(&format!("{name}/{label}"), |b| {
                 b.iter(|| {
                     k ^= 1;
                     sys.rhs(black_box(t + h), black_box(&states[k]), &mut dy)

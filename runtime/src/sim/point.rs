@@ -300,15 +300,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.solved.check(t, &self.q, &self.qd) {
             return Ok(());
         }
-        if !self.terms.check(t, &self.q, &self.qd) {
-            // The fused evaluation writes C_q and G at (t, q) too.
-            self.jacobian.valid = false;
-            self.ws
-                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
-                .map_err(SimErrorKind::from_eval)?;
-            self.terms.set(t, &self.q, &self.qd);
-            self.jacobian.set(t, &self.q, &[]);
-        }
+        self.dynamics_terms(t)?;
         self.factorizations += 1;
         let stats = self
             .dynamics
@@ -334,12 +326,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
-    /// $\lambda = 0$.
-    pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        if self.solved.check(t, &self.q, &self.qd) {
-            return Ok(());
-        }
+    /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
+    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too).
+    pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms.check(t, &self.q, &self.qd) {
             self.jacobian.valid = false;
             self.ws
@@ -348,6 +337,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.terms.set(t, &self.q, &self.qd);
             self.jacobian.set(t, &self.q, &[]);
         }
+        Ok(())
+    }
+
+    /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
+    /// $\lambda = 0$.
+    pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if self.solved.check(t, &self.q, &self.qd) {
+            return Ok(());
+        }
+        self.dynamics_terms(t)?;
         let info = self.info;
         let n = info.nq();
         if self.mass.matrix_mut().len() != n * n {

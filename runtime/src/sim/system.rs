@@ -213,6 +213,25 @@ impl<'a, M: Mechanism + ?Sized> StateSpace<'a, M> {
             .map_err(SimErrorKind::Analysis)
     }
 
+    /// The same system with the augmented system solved by `solver` (default
+    /// [`LinearSolver::Auto`](crate::LinearSolver::Auto): the model's generated solve
+    /// first); `LinearSolver::Dense` or `Sparse` force the general paths, for
+    /// comparisons.
+    ///
+    /// # Errors
+    /// A failed sparse symbolic factorization ([`SimErrorKind::Analysis`]).
+    pub fn linear_solver(mut self, solver: crate::LinearSolver) -> Result<Self, SimErrorKind> {
+        let point = &mut self.0.point;
+        let params = DynamicsParams {
+            solver,
+            ..*point.dynamics.params()
+        };
+        point.dynamics = crate::Dynamics::new(point.info, params)
+            .map_err(|e| SimErrorKind::Analysis(e.into()))?;
+        point.invalidate();
+        Ok(self)
+    }
+
     /// Starts from the consistent state `(t, q, q̇)` (as assembled, for example the
     /// model's initial state): Algorithm P picks the independent constraint rows, and
     /// the state becomes the last accepted one (for partitioning, the anchor of the
