@@ -1,14 +1,22 @@
-//! Cost of one evaluation of a deformable body as its number of modes grows: the
-//! spin-up beam (benchmark-models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 16
-//! clamped elements on a free hub, its invariants read from a beam data slot
-//! (`Beam { .., modes: n }`), for n = 4, 8, 16. Timed: the generated `mass_matrix` and
-//! `forces` at a state with every coordinate and velocity non-zero.
+//! Cost of a deformable body as its number of modes grows: the spin-up beam
+//! (benchmark-models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 32 clamped
+//! elements on a free hub, its invariants read from a beam data slot
+//! (`Beam { .., modes: n }`), for n = 4, 8 and 16. Timed:
+//! the generated `mass_matrix` and `forces` at a state with every coordinate and
+//! velocity non-zero, and a step of a simulation (100 fixed RK4 steps of 1e-5 s with
+//! coordinate partitioning, four index-1 right-hand sides each: M, Q, the solve).
+//!
+//! The issue also asks for 64 modes: the mode count is a literal of the source (it fixes
+//! the generated code's sizes, dense in the slot's entries), and a 64-mode body made
+//! rustc fail with SIGSEGV after 12 minutes of compiling this file (release profile),
+//! so it is not here.
 //!
 //! `cargo bench -p pfaff-tests --bench flex_modes`
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use pfaff::sim::{Method, Simulation};
 use pfaff::Mechanism;
 
 macro_rules! hub_beam {
@@ -20,7 +28,7 @@ macro_rules! hub_beam {
             const ei: f64 = 1.4e4;
             const rho_a: f64 = 1.2;
             static rod_fe: Data = Beam {
-                elements: 16,
+                elements: 32,
                 length: l,
                 rho_a: rho_a,
                 ea: ea,
@@ -46,7 +54,6 @@ hub_beam!(
     16,
     [p1, p2, p3, p4, p5, p6, p7, p8, p9, p10, p11, p12, p13, p14, p15, p16]
 );
-
 fn evaluation(c: &mut Criterion) {
     let models: [(usize, Box<dyn Mechanism>); 3] = [
         (4, Box::new(modes4::Model::default())),
@@ -65,6 +72,16 @@ fn evaluation(c: &mut Criterion) {
                 model.mass_matrix(0.0, black_box(&q), &mut m);
                 model.forces(0.0, black_box(&q), black_box(&qd), &mut f);
                 black_box((&m, &f));
+            });
+        });
+        c.bench_function(&format!("flex_modes/{n}/100_rk4_steps"), |b| {
+            b.iter(|| {
+                let run = Simulation::new(model.as_ref())
+                    .integrator(Method::Rk4 { h: 1e-5 })
+                    .output_times(&[])
+                    .run(1e-3)
+                    .expect("the hub beam runs");
+                black_box(run.stats.steps)
             });
         });
     }
