@@ -188,6 +188,19 @@ impl TestSet {
     }
 }
 
+/// A random state of the crank near the test set's: elastic coordinates of a millimetre,
+/// crank and rod rates of the run's size.
+fn crank_state(rng: &mut Rng) -> (Vec<f64>, Vec<f64>) {
+    let mut q = rng.vec(7);
+    for x in &mut q[3..] {
+        *x *= 1e-3;
+    }
+    let mut qd = rng.vec(7);
+    qd[0] *= 150.0;
+    qd[1] *= 75.0;
+    (q, qd)
+}
+
 /// The generated mass matrix, forces and constraints equal the test set's `AM`, `F` and
 /// constraints (benchmark-models.md) at random states to 1e-12 (relative to the largest
 /// entry), with gravity off (the test set's value) and on.
@@ -200,13 +213,7 @@ fn generated_equations_equal_the_test_set() {
         model.set_parameter(k, grav);
         let ts = test_set(grav);
         for _ in 0..20 {
-            let mut q = rng.vec(7);
-            for x in &mut q[3..] {
-                *x *= 1e-3;
-            }
-            let mut qd = rng.vec(7);
-            qd[0] *= 150.0;
-            qd[1] *= 75.0;
+            let (q, qd) = crank_state(&mut rng);
             let t = 0.01 * rng.next().abs();
             let mut m = vec![0.0; 49];
             model.mass_matrix_dense_inplace(t, &q, &mut m);
@@ -249,13 +256,7 @@ fn integrated_invariants_equal_the_closed_form_integrals() {
         model.set_parameter(k, grav);
         let cf = closed_form(grav);
         for _ in 0..20 {
-            let mut q = rng.vec(7);
-            for x in &mut q[3..] {
-                *x *= 1e-3;
-            }
-            let mut qd = rng.vec(7);
-            qd[0] *= 150.0;
-            qd[1] *= 75.0;
+            let (q, qd) = crank_state(&mut rng);
             let mut m = vec![0.0; 49];
             model.mass_matrix_dense_inplace(0.0, &q, &mut m);
             let am = cf.am(&q);

@@ -720,14 +720,10 @@ impl<'a> Builder<'_, 'a> {
         };
         let fv = self.tr.frames[k].clone();
         let dim = fv.dim;
-        let nq = self.tr.nq();
         let mass = self.scalar(fl.get("mass")?, Context::Kinematics)?;
         let com = self.at(&fl, "com", dim)?;
         let rc = fv.point(self.g(), &com);
-        let vc: Vec<ExprId> = rc
-            .iter()
-            .map(|&x| time_derivative(self.g(), nq, x))
-            .collect();
+        let vc: Vec<ExprId> = rc.iter().map(|&x| time_derivative(self.g(), x)).collect();
         let vv = dot(self.g(), &vc, &vc);
         let half = self.g().constant(0.5);
         let mut terms = vec![self.g().mul(vec![half, mass, vv])];
@@ -737,7 +733,7 @@ impl<'a> Builder<'_, 'a> {
             if dim == 2 {
                 let i = self.scalar(ie, Context::Kinematics)?;
                 principal.push(i);
-                let Value::Scalar(w) = fv.angular_velocity(self.g(), nq) else {
+                let Value::Scalar(w) = fv.angular_velocity(self.g()) else {
                     unreachable!("planar frames have a scalar rate")
                 };
                 terms.push(self.g().mul(vec![half, i, w, w]));
@@ -767,7 +763,7 @@ impl<'a> Builder<'_, 'a> {
                     }
                 }
                 principal.extend([inertia[0], inertia[4], inertia[8]]);
-                let w = fv.body_angular_velocity(self.g(), nq);
+                let w = fv.body_angular_velocity(self.g());
                 let iw = mat_vec(self.g(), 3, &inertia, &w);
                 let wiw = dot(self.g(), &w, &iw);
                 terms.push(self.g().mul(vec![half, wiw]));
@@ -816,7 +812,7 @@ impl<'a> Builder<'_, 'a> {
             Inertia::Scalar(m) => scale_v(g, *m, v),
             Inertia::Matrix(m) => mat_vec(g, k, m, v),
         };
-        let bias: Vec<ExprId> = u.iter().map(|&x| time_derivative(g, nq, x)).collect();
+        let bias: Vec<ExprId> = u.iter().map(|&x| time_derivative(g, x)).collect();
         let mut f = apply(g, &bias);
         if let Some(h) = gyroscopic {
             f = add_v(g, &f, h);
@@ -976,7 +972,6 @@ impl<'a> Builder<'_, 'a> {
         let dim = self.dim_of(a);
         let fa = self.tr.frame_value(a, dim);
         let fb = self.tr.frame_value(b, dim);
-        let nq = self.tr.nq();
         let at_a = self.at(&fl, "at_a", dim)?;
         let at_b = self.at(&fl, "at_b", dim)?;
         let pa = fa.point(self.g(), &at_a);
@@ -1139,10 +1134,7 @@ impl<'a> Builder<'_, 'a> {
                 } else {
                     self.vector(fl.get("along")?, dim, Context::Kinematics)?
                 };
-                let v: Vec<ExprId> = pa
-                    .iter()
-                    .map(|&x| time_derivative(self.g(), nq, x))
-                    .collect();
+                let v: Vec<ExprId> = pa.iter().map(|&x| time_derivative(self.g(), x)).collect();
                 nh.push(("", dot(self.g(), &v, &along)));
                 "ZeroVelocity"
             }
@@ -1188,11 +1180,8 @@ impl<'a> Builder<'_, 'a> {
                         up: up.0.clone(),
                     });
                 }
-                let vc: Vec<ExprId> = c
-                    .iter()
-                    .map(|&x| time_derivative(self.g(), nq, x))
-                    .collect();
-                let Value::Vector(omega) = fa.angular_velocity(self.g(), nq) else {
+                let vc: Vec<ExprId> = c.iter().map(|&x| time_derivative(self.g(), x)).collect();
+                let Value::Vector(omega) = fa.angular_velocity(self.g()) else {
                     unreachable!("spatial frames have a vector rate")
                 };
                 let spin = cross(self.g(), &omega, &down);
@@ -1564,7 +1553,7 @@ impl<'a> Builder<'_, 'a> {
                 self.potential.push(v);
                 if let Some(ce) = fl.get("damping") {
                     let c = self.scalar(ce, Context::Kinematics)?;
-                    let ld = time_derivative(self.g(), nq, l);
+                    let ld = time_derivative(self.g(), l);
                     let q = (0..nq)
                         .map(|i| {
                             let dl = diff::differentiate(self.g(), l, Var::Q(idx(i)));
@@ -1598,7 +1587,7 @@ impl<'a> Builder<'_, 'a> {
                 let dim = self.dim_of(a);
                 let fa = self.tr.frame_value(a, dim);
                 let te = fl.get("torque")?;
-                let w = fa.angular_velocity(self.g(), nq);
+                let w = fa.angular_velocity(self.g());
                 let q: Vec<ExprId> = match w {
                     Value::Scalar(w) => {
                         let tau = self.scalar(te, Context::Force)?;

@@ -730,7 +730,6 @@ impl Builder<'_, '_> {
         inv: &Invariants,
         qf: &[u32],
     ) -> ExprId {
-        let nq = self.tr.nq();
         let g = &mut *self.tr.g;
         let dim = fv.dim;
         let nf = qf.len();
@@ -757,11 +756,7 @@ impl Builder<'_, '_> {
                 p.push(g.add(vec![pl, pq]));
             }
         }
-        let rd: Vec<ExprId> = fv
-            .origin
-            .iter()
-            .map(|&x| time_derivative(g, nq, x))
-            .collect();
+        let rd: Vec<ExprId> = fv.origin.iter().map(|&x| time_derivative(g, x)).collect();
         let sqd = mat_vec_rect(g, &inv.s_bar, nf, &qd);
         let mut terms = Vec::new();
         let rr = dot(g, &rd, &rd);
@@ -771,7 +766,7 @@ impl Builder<'_, '_> {
         let ff = dot(g, &qd, &mq);
         terms.push(g.mul(vec![half, ff]));
         if dim == 2 {
-            let Value::Scalar(w) = fv.angular_velocity(g, nq) else {
+            let Value::Scalar(w) = fv.angular_velocity(g) else {
                 unreachable!("planar frames have a scalar rate")
             };
             // ω̄ × ū_c = w (−u_c2, u_c1)
@@ -785,7 +780,7 @@ impl Builder<'_, '_> {
             let h = g.sub(p[1], p[2]);
             terms.push(g.mul(vec![w, h]));
         } else {
-            let w = fv.body_angular_velocity(g, nq);
+            let w = fv.body_angular_velocity(g);
             let wu = cross(g, &w, &uc);
             let b: Vec<ExprId> = (0..3).map(|i| g.add(vec![wu[i], sqd[i]])).collect();
             let ab = mat_vec(g, 3, &fv.rotation, &b);
@@ -841,12 +836,12 @@ impl Builder<'_, '_> {
                 let frame = self.tr.frames[frame].clone();
                 let g = &mut *self.tr.g;
                 let w2 = if dim == 2 {
-                    let Value::Scalar(w) = frame.angular_velocity(g, nq) else {
+                    let Value::Scalar(w) = frame.angular_velocity(g) else {
                         unreachable!("planar frames have a scalar rate")
                     };
                     g.powi(w, 2)
                 } else {
-                    let w = frame.body_angular_velocity(g, nq);
+                    let w = frame.body_angular_velocity(g);
                     let wy = g.powi(w[1], 2);
                     let wz = g.powi(w[2], 2);
                     g.add(vec![wy, wz])

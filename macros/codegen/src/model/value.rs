@@ -200,8 +200,8 @@ pub fn transpose(n: usize, m: &[ExprId]) -> Vec<ExprId> {
     out
 }
 
-/// `d/dt e` along the motion: `Σ ∂e/∂q_i q̇_i + ∂e/∂t`.
-pub fn time_derivative(g: &mut Graph, _nq: usize, e: ExprId) -> ExprId {
+/// `d/dt e` along the motion at `q̈ = 0`: `Σ ∂e/∂q_i q̇_i + ∂e/∂t` ([`diff::rate`]).
+pub fn time_derivative(g: &mut Graph, e: ExprId) -> ExprId {
     diff::rate(g, e)
 }
 
@@ -288,12 +288,12 @@ impl FrameValue {
 
     /// The global angular velocity: a scalar rate for planar frames, a 3-vector for
     /// spatial ones (`2 E θ̇` for Euler parameters, else the axial vector of `Ȧ Aᵀ`).
-    pub fn angular_velocity(&self, g: &mut Graph, nq: usize) -> Value {
+    pub fn angular_velocity(&self, g: &mut Graph) -> Value {
         if let Some(a) = self.angle {
-            return Value::Scalar(time_derivative(g, nq, a));
+            return Value::Scalar(time_derivative(g, a));
         }
         if let Some(e) = self.euler {
-            let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, nq, x)).collect();
+            let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, x)).collect();
             let em = euler_e(e, g);
             let w = (0..3)
                 .map(|i| {
@@ -307,7 +307,7 @@ impl FrameValue {
         let ad: Vec<ExprId> = self
             .rotation
             .iter()
-            .map(|&x| time_derivative(g, nq, x))
+            .map(|&x| time_derivative(g, x))
             .collect();
         let at = transpose(3, &self.rotation);
         let w = mat_mat(g, 3, &ad, &at);
@@ -316,9 +316,9 @@ impl FrameValue {
 
     /// The angular velocity in frame components (spatial frames): `2 Ē θ̇` for Euler
     /// parameters, else the axial vector of `Aᵀ Ȧ`.
-    pub fn body_angular_velocity(&self, g: &mut Graph, nq: usize) -> Vec<ExprId> {
+    pub fn body_angular_velocity(&self, g: &mut Graph) -> Vec<ExprId> {
         if let Some(e) = self.euler {
-            let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, nq, x)).collect();
+            let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, x)).collect();
             let em = euler_e_bar(e, g);
             return (0..3)
                 .map(|i| {
@@ -331,7 +331,7 @@ impl FrameValue {
         let ad: Vec<ExprId> = self
             .rotation
             .iter()
-            .map(|&x| time_derivative(g, nq, x))
+            .map(|&x| time_derivative(g, x))
             .collect();
         let at = transpose(3, &self.rotation);
         let w = mat_mat(g, 3, &at, &ad);
@@ -759,16 +759,14 @@ impl Translator<'_> {
                 );
                 return None;
             }
-            let nq = self.nq();
             return Some(match recv {
-                Value::Scalar(x) => Value::Scalar(time_derivative(self.g, nq, x)),
+                Value::Scalar(x) => Value::Scalar(time_derivative(self.g, x)),
                 Value::Vector(c) => {
-                    Value::Vector(c.iter().map(|&x| time_derivative(self.g, nq, x)).collect())
+                    Value::Vector(c.iter().map(|&x| time_derivative(self.g, x)).collect())
                 }
-                Value::Matrix(n, c) => Value::Matrix(
-                    n,
-                    c.iter().map(|&x| time_derivative(self.g, nq, x)).collect(),
-                ),
+                Value::Matrix(n, c) => {
+                    Value::Matrix(n, c.iter().map(|&x| time_derivative(self.g, x)).collect())
+                }
                 Value::Frame(_) => unreachable!("frames handled above"),
             });
         }
@@ -884,7 +882,6 @@ impl Translator<'_> {
             );
             return None;
         }
-        let nq = self.nq();
         Some(match name {
             "origin" => Value::Vector(fv.origin.clone()),
             "rotation" => Value::Matrix(dim, fv.rotation.clone()),
@@ -907,9 +904,9 @@ impl Translator<'_> {
             "velocity" => {
                 let u = self.vector(&m.args[0], Some(dim))?;
                 let p = fv.point(self.g, &u);
-                Value::Vector(p.iter().map(|&x| time_derivative(self.g, nq, x)).collect())
+                Value::Vector(p.iter().map(|&x| time_derivative(self.g, x)).collect())
             }
-            "angular_velocity" => fv.angular_velocity(self.g, nq),
+            "angular_velocity" => fv.angular_velocity(self.g),
             "material" => {
                 let material = f.and_then(|k| {
                     self.materials
