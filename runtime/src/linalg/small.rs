@@ -176,7 +176,10 @@ impl SmallCholesky {
     /// Makes it the factorization of an `n × n` matrix, `n` at most the size it was
     /// created with (no allocation).
     pub fn resize(&mut self, n: usize) {
-        assert!(n <= self.scale.len(), "SmallCholesky::resize beyond its capacity");
+        assert!(
+            n <= self.scale.len(),
+            "SmallCholesky::resize beyond its capacity"
+        );
         self.n = n;
     }
 

@@ -120,7 +120,13 @@ pub(crate) struct Chart {
 /// Writes $(A_R A_R^\mathsf{T})^{-1}A_R$ of the rows `rows` of the dense row-major `a`
 /// (`· × n`) into `map` (row-major `|R| × n`), with `gram` (of size `|R|`) as scratch;
 /// returns the pivot ratio of the Gram matrix.
-fn normal_map(gram: &mut SmallCholesky, map: &mut [f64], a: &[f64], rows: &[usize], n: usize) -> f64 {
+fn normal_map(
+    gram: &mut SmallCholesky,
+    map: &mut [f64],
+    a: &[f64],
+    rows: &[usize],
+    n: usize,
+) -> f64 {
     let ratio = gram_cholesky(gram, a, rows, n);
     for (out, &i) in map.chunks_exact_mut(n.max(1)).zip(rows) {
         out.copy_from_slice(&a[i * n..(i + 1) * n]);
@@ -132,7 +138,13 @@ fn normal_map(gram: &mut SmallCholesky, map: &mut [f64], a: &[f64], rows: &[usiz
 /// $x \leftarrow x - M^\mathsf{T}\mu$ for the map `map` (`|μ| × n`, row-major), with
 /// `dx` (length `n`) as scratch; returns the largest change and the largest in the
 /// weights $\text{atol} + \text{rtol}\,|x_j|$ (at the new values).
-fn update(map: &[f64], mu: &[f64], x: &mut [f64], dx: &mut [f64], (rtol, atol): (f64, f64)) -> (f64, f64) {
+fn update(
+    map: &[f64],
+    mu: &[f64],
+    x: &mut [f64],
+    dx: &mut [f64],
+    (rtol, atol): (f64, f64),
+) -> (f64, f64) {
     let n = x.len();
     dx.fill(0.0);
     for (row, m) in map.chunks_exact(n.max(1)).zip(mu) {
