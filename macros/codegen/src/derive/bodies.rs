@@ -712,8 +712,13 @@ impl<'a> Builder<'_, 'a> {
                 let nw: Vec<ExprId> = w.iter().map(|&x| g.neg(x)).collect();
                 let skew = [zero, nw[2], w[1], w[2], zero, nw[0], nw[1], w[0], zero];
                 let ad = mat_mat(g, 3, &rotation, &skew);
+                // Sums only: a product's forward rate is as short, and other
+                // expressions share product nodes (`cos φ cos θ`) whose own rates
+                // simplify better.
                 for (&e, &r) in rotation.iter().zip(&ad) {
-                    diff::declare_rate(g, e, r);
+                    if matches!(g.node(e), crate::sym::Node::Add(_)) {
+                        diff::declare_rate(g, e, r);
+                    }
                 }
             }
         }
@@ -1499,7 +1504,15 @@ impl<'a> Builder<'_, 'a> {
                 let na = dot(self.g(), &up.0, &a);
                 let proj = scale_v(self.g(), na, &a);
                 let w = sub_v(self.g(), &up.0, &proj);
-                let wsq = dot(self.g(), &w, &w);
+                // |w|² = 1 − (n·a)² for unit `n` and `a`; `a` is a unit vector for every
+                // `q` when the frame's rotation is built from axis rotations.
+                let wsq = if fa.exact_rates {
+                    let one = self.g().constant(1.0);
+                    let na2 = self.g().mul(vec![na, na]);
+                    self.g().sub(one, na2)
+                } else {
+                    dot(self.g(), &w, &w)
+                };
                 let wn = self.g().call(Func::Sqrt, wsq);
                 let mr = self.g().neg(radius);
                 let s = self.g().div(mr, wn);

@@ -368,6 +368,24 @@ impl FrameValue {
                 .collect();
             return Value::Vector(w);
         }
+        let parent = self.velocity.as_ref().and_then(|v| v.in_parent.as_ref());
+        if let (Some(p), true) = (parent, self.exact_rates) {
+            // In the parent's components the joint's own angle does not enter:
+            // `ω = A_p (F ω̄)`, and its rate `A_p ((F ω̄)˙ + ω̄_p × F ω̄)`.
+            let out = mat_vec(g, 3, &p.rotation, &p.frame_omega);
+            let wd: Vec<ExprId> = p
+                .frame_omega
+                .iter()
+                .map(|&x| time_derivative(g, x))
+                .collect();
+            let turn = cross(g, &p.omega, &p.frame_omega);
+            let local = add_v(g, &wd, &turn);
+            let r = mat_vec(g, 3, &p.rotation, &local);
+            for (&e, &x) in out.iter().zip(&r) {
+                diff::declare_rate(g, e, x);
+            }
+            return Value::Vector(out);
+        }
         if let Some(w) = &self.omega {
             let out = mat_vec(g, 3, &self.rotation, w);
             if self.exact_rates {
