@@ -55,6 +55,36 @@ pub struct FrameValue {
     pub angle: Option<ExprId>,
     /// Frames oriented by Euler parameters: the four parameters.
     pub euler: Option<[ExprId; 4]>,
+    /// Spatial frames: the angular velocity in the frame's own components, built down
+    /// the frame tree (`ω̄ = Fᵀ ω̄_before + ω̄_F` for each factor `F` of a relative
+    /// rotation) rather than from the derivative of the composed rotation matrix.
+    pub omega: Option<Vec<ExprId>>,
+    /// Spatial frames: the origin's velocity in two pieces, `v_o = b + A r`. The base
+    /// `b` (global components) is the velocity of the origin of the topmost frame below
+    /// the ground, the rate of its origin expression (`[ẋ, ẏ, ż]` for a body given
+    /// by absolute coordinates); `r` is the rest, in the frame's own components, built
+    /// down the frame tree: `r = Fᵀ (r_p + ω̄_p × o + ȯ)` with `o` the origin in the
+    /// parent's components and `F` the relative rotation. Kane's method dots the pieces
+    /// each in its own components (`derive/bodies.rs`).
+    pub velocity: Option<FrameVelocity>,
+    /// Whether [`Self::omega`] and [`Self::velocity`] are the rates of the rotation and
+    /// the origin for every `q`: every factor of the rotations down the tree is a
+    /// coordinate-axis rotation or constant. With Euler parameters they are so only on
+    /// the normalization's manifold, which is enough for the mass matrix and forces
+    /// but not for a Jacobian read from a velocity.
+    pub exact_rates: bool,
+}
+
+/// The two pieces of a spatial frame's origin velocity (see [`FrameValue::velocity`]).
+#[derive(Clone, Debug)]
+pub struct FrameVelocity {
+    /// `b`, global components.
+    pub base: Vec<ExprId>,
+    /// `r`, in the frame's components.
+    pub relative: Vec<ExprId>,
+    /// `r` in the parent's components (before the relative rotation), with the
+    /// parent's rotation and angular velocity; `None` below the ground.
+    pub in_parent: Option<(Vec<ExprId>, Vec<ExprId>, Vec<ExprId>)>,
 }
 
 /// A closure of the description, `|xi| body`: a function of one material coordinate.
@@ -286,6 +316,26 @@ impl FrameValue {
         add_v(g, &self.origin, &au)
     }
 
+    /// The global velocity of the point with frame coordinates `u`: from the frame
+    /// tree's pieces (`b + A_p r_p` at the origin when the frame has a parent, else
+    /// `b + A (r + ω̄ × u)`) for spatial frames, else the rate of its position.
+    pub fn point_velocity(&self, g: &mut Graph, u: &[ExprId]) -> Vec<ExprId> {
+        if let (Some(vel), Some(w), true) = (&self.velocity, &self.omega, self.exact_rates) {
+            let at_origin = u.iter().all(|&x| g.is_zero(x));
+            let (a, r) = match (&vel.in_parent, at_origin) {
+                (Some((rp, ap, _)), true) => (ap.clone(), rp.clone()),
+                _ => {
+                    let wu = cross(g, w, u);
+                    (self.rotation.clone(), add_v(g, &vel.relative, &wu))
+                }
+            };
+            let ar = mat_vec(g, 3, &a, &r);
+            return add_v(g, &vel.base, &ar);
+        }
+        let p = self.point(g, u);
+        p.iter().map(|&x| time_derivative(g, x)).collect()
+    }
+
     /// The global angular velocity: a scalar rate for planar frames, a 3-vector for
     /// spatial ones (`2 E θ̇` for Euler parameters, else the axial vector of `Ȧ Aᵀ`).
     pub fn angular_velocity(&self, g: &mut Graph) -> Value {
@@ -304,6 +354,9 @@ impl FrameValue {
                 .collect();
             return Value::Vector(w);
         }
+        if let Some(w) = &self.omega {
+            return Value::Vector(mat_vec(g, 3, &self.rotation, w));
+        }
         let ad: Vec<ExprId> = self
             .rotation
             .iter()
@@ -317,6 +370,9 @@ impl FrameValue {
     /// The angular velocity in frame components (spatial frames): `2 Ē θ̇` for Euler
     /// parameters, else the axial vector of `Aᵀ Ȧ`.
     pub fn body_angular_velocity(&self, g: &mut Graph) -> Vec<ExprId> {
+        if let Some(w) = &self.omega {
+            return w.clone();
+        }
         if let Some(e) = self.euler {
             let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, x)).collect();
             let em = euler_e_bar(e, g);
@@ -840,6 +896,13 @@ impl Translator<'_> {
                     rotation,
                     angle: (dim == 2).then_some(z),
                     euler: None,
+                    omega: (dim == 3).then(|| vec![z; 3]),
+                    velocity: (dim == 3).then(|| FrameVelocity {
+                        base: vec![z; 3],
+                        relative: vec![z; 3],
+                        in_parent: None,
+                    }),
+                    exact_rates: true,
                 }
             }
         }
