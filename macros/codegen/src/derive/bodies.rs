@@ -31,7 +31,7 @@ use crate::ctxt::{suggest, Ctxt};
 use crate::model::expr::{Context, Translator};
 use crate::model::value::{
     add_v, cross, dot, mat_mat, mat_vec, scale_v, sub_v, time_derivative, FrameValue,
-    FrameVelocity, Value,
+    FrameVelocity, InParent, Value,
 };
 use crate::parse::{Decl, DeclKind};
 use crate::sym::{diff, transform, Deps, ExprId, Func, Graph, Var};
@@ -644,10 +644,12 @@ impl<'a> Builder<'_, 'a> {
             }
         };
         let mut exact_rates = pv.exact_rates;
+        let mut omega_in_parent = None;
         let omega = match (dim, fl.get("rotation"), &pv.omega) {
             (3, Some(r), Some(w)) => {
-                let (w, exact) = self.relative_rate(r, &rel_rotation, w)?;
+                let (w, wp, exact) = self.relative_rate(r, &rel_rotation, w)?;
                 exact_rates &= exact;
+                omega_in_parent = Some(wp);
                 Some(w)
             }
             _ => None,
@@ -678,7 +680,13 @@ impl<'a> Builder<'_, 'a> {
                 Some(FrameVelocity {
                     base: pvel.base.clone(),
                     relative,
-                    in_parent: Some((rp, pv.rotation.clone(), wp.clone())),
+                    in_parent: Some(InParent {
+                        velocity: rp,
+                        rotation: pv.rotation.clone(),
+                        omega: wp.clone(),
+                        relative: rel_rotation.clone(),
+                        frame_omega: omega_in_parent.clone().expect("spatial frame"),
+                    }),
                 })
             }
             _ => None,
@@ -695,6 +703,25 @@ impl<'a> Builder<'_, 'a> {
             (Some(a), _) => Some(a),
             _ => None,
         };
+        if dim == 3 && exact_rates {
+            if let Some(w) = &omega {
+                // `Ȧ = A ω̃`: three operations an entry instead of the forward rate of
+                // the product of the rotations down the tree.
+                let g = self.g();
+                let zero = g.constant(0.0);
+                let nw: Vec<ExprId> = w.iter().map(|&x| g.neg(x)).collect();
+                let skew = [zero, nw[2], w[1], w[2], zero, nw[0], nw[1], w[0], zero];
+                let ad = mat_mat(g, 3, &rotation, &skew);
+                // Sums only: a product's forward rate is as short, and other
+                // expressions share product nodes (`cos φ cos θ`) whose own rates
+                // simplify better.
+                for (&e, &r) in rotation.iter().zip(&ad) {
+                    if matches!(g.node(e), crate::sym::Node::Add(_)) {
+                        diff::declare_rate(g, e, r);
+                    }
+                }
+            }
+        }
         let value = FrameValue {
             dim,
             origin,
@@ -729,14 +756,15 @@ impl<'a> Builder<'_, 'a> {
     /// factor, `ω̄ ← Fᵀ ω̄ + ω̄_F`, with `ω̄_F` the rate `ȧ e_k` of `rot_x/y/z(a)`, `2Ē θ̇`
     /// of `euler_parameters`, zero for a constant factor, and the axial vector of `FᵀḞ`
     /// otherwise (also for a whole rotation that is not a product of 3×3 matrices).
-    /// Also returns whether every factor is a coordinate-axis rotation or constant
-    /// ([`FrameValue::exact_rates`]).
+    /// Also returns the same angular velocity in the parent's components
+    /// (`ω̄_p + Σ_k F_1⋯F_k ω̄_{F_k}`) and whether every factor is a coordinate-axis
+    /// rotation or constant ([`FrameValue::exact_rates`]).
     fn relative_rate(
         &mut self,
         rotation: &syn::Expr,
         rel: &[ExprId],
         w: &[ExprId],
-    ) -> Option<(Vec<ExprId>, bool)> {
+    ) -> Option<(Vec<ExprId>, Vec<ExprId>, bool)> {
         fn flatten<'e>(e: &'e syn::Expr, out: &mut Vec<&'e syn::Expr>) {
             match e {
                 syn::Expr::Paren(p) => flatten(&p.expr, out),
@@ -760,16 +788,22 @@ impl<'a> Builder<'_, 'a> {
                 }
             }
         }
+        let mut w_parent = w.to_vec();
         let mut w = w.to_vec();
         let mut exact = true;
+        let (o, z) = (self.g().constant(1.0), self.g().constant(0.0));
+        let mut prefix = vec![o, z, z, z, o, z, z, z, o];
         for (e, m) in factors {
             let (own, elementary) = self.factor_rate(e, &m)?;
             exact &= elementary;
+            prefix = mat_mat(self.g(), 3, &prefix, &m);
+            let seen = mat_vec(self.g(), 3, &prefix, &own);
+            w_parent = add_v(self.g(), &w_parent, &seen);
             let mt = crate::model::value::transpose(3, &m);
             let turned = mat_vec(self.g(), 3, &mt, &w);
             w = add_v(self.g(), &turned, &own);
         }
-        Some((w, exact))
+        Some((w, w_parent, exact))
     }
 
     /// `ω̄_F` of one factor `F = m` of a rotation (see [`Self::relative_rate`]).
@@ -878,7 +912,7 @@ impl<'a> Builder<'_, 'a> {
                 // the joint's own angle), else of the body's frame.
                 let com_zero = com.iter().all(|&x| self.tr.g.is_zero(x));
                 let (rot, omega_e, u) = match (&vel.in_parent, com_zero) {
-                    (Some((rp, ap, wp)), true) => (ap.clone(), wp.clone(), rp.clone()),
+                    (Some(p), true) => (p.rotation.clone(), p.omega.clone(), p.velocity.clone()),
                     _ => {
                         let wc = cross(self.g(), w, &com);
                         let u = add_v(self.g(), &vel.relative, &wc);
@@ -957,6 +991,30 @@ impl<'a> Builder<'_, 'a> {
                     }
                 }
                 principal.extend([inertia[0], inertia[4], inertia[8]]);
+                // An inertia the joint's rotation leaves unchanged (a wheel spinning on
+                // its axle) is taken in the parent's components, where the spin angle
+                // does not enter: `Ī_p = F Ī Fᵀ`, the rate `F ω̄`, and the gyroscopic
+                // term with the parent's angular velocity, `ω̄_p × Ī_p ω`.
+                let parent_view = fv.velocity.as_ref().and_then(|v| v.in_parent.clone());
+                if let Some(p) = parent_view {
+                    let g = self.g();
+                    let fi = mat_mat(g, 3, &p.relative, &inertia);
+                    let ft = crate::model::value::transpose(3, &p.relative);
+                    let ip = mat_mat(g, 3, &fi, &ft);
+                    let constant = ip.iter().all(|&x| {
+                        let d = g.deps(x);
+                        !d.has(Deps::Q) && !d.has(Deps::TIME)
+                    });
+                    if constant {
+                        let w = p.frame_omega.clone();
+                        let iw = mat_vec(g, 3, &ip, &w);
+                        let wiw = dot(g, &w, &iw);
+                        terms.push(g.mul(vec![half, wiw]));
+                        let gyroscopic = cross(g, &p.omega, &iw);
+                        self.kane(&w, &Inertia::Matrix(ip), Some(&gyroscopic));
+                        return self.finish_body(d, k, mass, rc, principal, terms);
+                    }
+                }
                 let w = fv.body_angular_velocity(self.g());
                 let iw = mat_vec(self.g(), 3, &inertia, &w);
                 let wiw = dot(self.g(), &w, &iw);
@@ -965,6 +1023,19 @@ impl<'a> Builder<'_, 'a> {
                 self.kane(&w, &Inertia::Matrix(inertia.clone()), Some(&gyroscopic));
             }
         }
+        self.finish_body(d, k, mass, rc, principal, terms)
+    }
+
+    /// Records a rigid body's energy, gravity, drawing and output entry.
+    fn finish_body(
+        &mut self,
+        d: &Decl,
+        k: usize,
+        mass: ExprId,
+        rc: Vec<ExprId>,
+        principal: Vec<ExprId>,
+        terms: Vec<ExprId>,
+    ) -> Option<()> {
         let t = self.g().add(terms);
         self.kinetic.push(t);
         self.masses.push((mass, rc));
@@ -1433,7 +1504,15 @@ impl<'a> Builder<'_, 'a> {
                 let na = dot(self.g(), &up.0, &a);
                 let proj = scale_v(self.g(), na, &a);
                 let w = sub_v(self.g(), &up.0, &proj);
-                let wsq = dot(self.g(), &w, &w);
+                // |w|² = 1 − (n·a)² for unit `n` and `a`; `a` is a unit vector for every
+                // `q` when the frame's rotation is built from axis rotations.
+                let wsq = if fa.exact_rates {
+                    let one = self.g().constant(1.0);
+                    let na2 = self.g().mul(vec![na, na]);
+                    self.g().sub(one, na2)
+                } else {
+                    dot(self.g(), &w, &w)
+                };
                 let wn = self.g().call(Func::Sqrt, wsq);
                 let mr = self.g().neg(radius);
                 let s = self.g().div(mr, wn);

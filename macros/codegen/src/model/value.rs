@@ -82,9 +82,23 @@ pub struct FrameVelocity {
     pub base: Vec<ExprId>,
     /// `r`, in the frame's components.
     pub relative: Vec<ExprId>,
-    /// `r` in the parent's components (before the relative rotation), with the
-    /// parent's rotation and angular velocity; `None` below the ground.
-    pub in_parent: Option<(Vec<ExprId>, Vec<ExprId>, Vec<ExprId>)>,
+    /// The frame seen from its parent; `None` below the ground.
+    pub in_parent: Option<InParent>,
+}
+
+/// A spatial frame's motion in its parent's components (see [`FrameVelocity`]).
+#[derive(Clone, Debug)]
+pub struct InParent {
+    /// `r` before the relative rotation: `r_p + ω̄_p × o + ȯ`.
+    pub velocity: Vec<ExprId>,
+    /// The parent's global rotation.
+    pub rotation: Vec<ExprId>,
+    /// The parent's angular velocity (its components).
+    pub omega: Vec<ExprId>,
+    /// The relative rotation `F` (parent ← frame).
+    pub relative: Vec<ExprId>,
+    /// This frame's angular velocity in the parent's components, `F ω̄`.
+    pub frame_omega: Vec<ExprId>,
 }
 
 /// A closure of the description, `|xi| body`: a function of one material coordinate.
@@ -323,7 +337,7 @@ impl FrameValue {
         if let (Some(vel), Some(w), true) = (&self.velocity, &self.omega, self.exact_rates) {
             let at_origin = u.iter().all(|&x| g.is_zero(x));
             let (a, r) = match (&vel.in_parent, at_origin) {
-                (Some((rp, ap, _)), true) => (ap.clone(), rp.clone()),
+                (Some(p), true) => (p.rotation.clone(), p.velocity.clone()),
                 _ => {
                     let wu = cross(g, w, u);
                     (self.rotation.clone(), add_v(g, &vel.relative, &wu))
@@ -354,8 +368,35 @@ impl FrameValue {
                 .collect();
             return Value::Vector(w);
         }
+        let parent = self.velocity.as_ref().and_then(|v| v.in_parent.as_ref());
+        if let (Some(p), true) = (parent, self.exact_rates) {
+            // In the parent's components the joint's own angle does not enter:
+            // `ω = A_p (F ω̄)`, and its rate `A_p ((F ω̄)˙ + ω̄_p × F ω̄)`.
+            let out = mat_vec(g, 3, &p.rotation, &p.frame_omega);
+            let wd: Vec<ExprId> = p
+                .frame_omega
+                .iter()
+                .map(|&x| time_derivative(g, x))
+                .collect();
+            let turn = cross(g, &p.omega, &p.frame_omega);
+            let local = add_v(g, &wd, &turn);
+            let r = mat_vec(g, 3, &p.rotation, &local);
+            for (&e, &x) in out.iter().zip(&r) {
+                diff::declare_rate(g, e, x);
+            }
+            return Value::Vector(out);
+        }
         if let Some(w) = &self.omega {
-            return Value::Vector(mat_vec(g, 3, &self.rotation, w));
+            let out = mat_vec(g, 3, &self.rotation, w);
+            if self.exact_rates {
+                // `d/dt (A ω̄) = A ω̄̇ + A ω̃ ω̄ = A ω̄̇`.
+                let wd: Vec<ExprId> = w.iter().map(|&x| time_derivative(g, x)).collect();
+                let r = mat_vec(g, 3, &self.rotation, &wd);
+                for (&e, &x) in out.iter().zip(&r) {
+                    diff::declare_rate(g, e, x);
+                }
+            }
+            return Value::Vector(out);
         }
         let ad: Vec<ExprId> = self
             .rotation
