@@ -511,6 +511,8 @@ pub trait Mechanism {
     /// point with `C_q` and `G` this way, so that the generated code computes what the
     /// two parts share (the sines of the same angles) once. The default evaluates the
     /// Jacobians, calls `correct`, then [`dynamics_terms`](Self::dynamics_terms).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
     fn dynamics_terms_corrected(
         &self,
         t: f64,

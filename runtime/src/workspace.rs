@@ -517,6 +517,8 @@ impl Workspace {
     /// [`Mechanism::dynamics_terms_corrected`]: `correct(cq, g, ct, bias, qd)` may change
     /// `qd` between the position terms and the velocity terms; the rates $C_t$, $g$ it
     /// reads must have been evaluated at `(t, q)` ([`eval_rates`](Self::eval_rates)).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
     pub fn eval_dynamics_terms_corrected<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,

@@ -346,6 +346,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// of $C_q$, $G$ and the rates at the current $(t, q)$, then $M$, $Q$ and $\gamma$ at
     /// the corrected velocities, from one call of the model's fused evaluation
     /// ([`Mechanism::dynamics_terms_corrected`]).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
     pub fn dynamics_terms_corrected(
         &mut self,
         t: f64,

@@ -23,8 +23,12 @@ use crate::derive::Derived;
 use crate::sched;
 use crate::sym::{transform, Graph, Node, Var};
 
-/// The trait method, or nothing when no output depends on a velocity (the default,
-/// which calls `dynamics_terms`, then does the same work).
+/// The trait method, or nothing (the trait's default, which evaluates `C_q` and `G`
+/// on their own, then `dynamics_terms`) when the model has no constraint rows, when no
+/// output depends on a velocity, or when `dynamics_terms` has more than [`MAX_LETS`]
+/// temporaries: the function repeats `dynamics_terms`, and for the largest models
+/// (long chains, many elastic modes) compiling it twice costs more than the shared
+/// sines save.
 pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
     let parts: [(&str, Vec<_>); 6] = [
         ("mass", entries(&d.mass)),
@@ -42,8 +46,11 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
             slots.push((Ident::new(field, Span::call_site()), k));
         }
     }
+    if d.cq.is_empty() && d.gm.is_empty() {
+        return TokenStream::new();
+    }
     let prog = sched::schedule(g, &roots);
-    if !prog.vars.iter().any(|v| matches!(v, Var::Qd(_))) {
+    if !prog.vars.iter().any(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
         return TokenStream::new();
     }
     // Which nodes depend on a velocity, from their operands (post-order).
@@ -55,12 +62,13 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
             node => node.args().into_iter().any(|a| moving[a.index()]),
         };
     }
-    let array = (prog.lets.len() > MAX_LETS).then(|| Ident::new(&names.temps, Span::call_site()));
+
+    // At most MAX_LETS temporaries: each is a `let` (see `super::body`).
     let printer = Printer {
         g,
         prog: &prog,
         names,
-        array: array.clone(),
+        array: None,
     };
     let mut before = TokenStream::new();
     let mut after = TokenStream::new();
@@ -87,19 +95,10 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
             }
         }
     }
-    if let Some(array) = &array {
-        let len = Literal::usize_unsuffixed(prog.lets.len());
-        before.extend(quote!(let mut #array = [0.0_f64; #len];));
-    }
     for (k, &id) in prog.lets.iter().enumerate() {
         let (ts, _) = printer.expr(id, true);
-        let stmt = if let Some(array) = &array {
-            let k = Literal::usize_unsuffixed(k);
-            quote!(#array[#k] = #ts;)
-        } else {
-            let name = names.temp(k);
-            quote!(let #name = #ts;)
-        };
+        let name = names.temp(k);
+        let stmt = quote!(let #name = #ts;);
         if moving[id.index()] {
             after.extend(stmt);
         } else {
