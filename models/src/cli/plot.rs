@@ -219,7 +219,7 @@ pub fn work_precision(model: &str, t_end: f64, rows: &[Row], path: &Path) -> Res
     chart
         .configure_mesh()
         .x_desc("wall time [s]")
-        .y_desc("final error (max abs)")
+        .y_desc("final error (relative)")
         .x_label_formatter(&|v| format!("{v:.0e}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()

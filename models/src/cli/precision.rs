@@ -76,7 +76,7 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     }
     let rows = work_precision(model.as_ref(), &sweep, &reference);
     println!(
-        "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference|, reference: {source}",
+        "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference| over the largest |q|, |q'| of the reference (at least 1), reference: {source}",
         entry.name
     );
     if entry.stiff && !args.all_methods {

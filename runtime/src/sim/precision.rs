@@ -82,8 +82,11 @@ impl Reference {
         Some(err)
     }
 
-    /// The largest absolute difference between the final row of `run` and the
-    /// reference values (`NaN` for an unknown name or an empty run).
+    /// The error of the final row of `run`: the largest difference from the reference
+    /// values, positions and velocities each relative to the largest magnitude of their
+    /// kind in the reference (at least 1), so that fast velocities (`andrews` turns at
+    /// about 1,000 rad/s) do not hide the positions' error and the figure reads against
+    /// rtol. `NaN` for an unknown name or an empty run.
     #[must_use]
     pub fn error(&self, run: &Run) -> f64 {
         let info = run.trajectory.info();
@@ -92,9 +95,10 @@ impl Reference {
         };
         let mut err = 0.0_f64;
         for (list, v) in [(&self.coordinates, q), (&self.velocities, qd)] {
+            let scale = list.iter().fold(1.0_f64, |a, (_, x)| a.max(x.abs()));
             for (name, x) in list {
                 match info.coordinate_index(name) {
-                    Some(j) => err = err.max((v[j] - x).abs()),
+                    Some(j) => err = err.max((v[j] - x).abs() / scale),
                     None => return f64::NAN,
                 }
             }
@@ -148,7 +152,8 @@ pub struct Row {
     pub method: Method,
     /// Relative tolerance.
     pub rtol: f64,
-    /// Final error against the reference (`NaN` when the run failed).
+    /// Final error against the reference, relative ([`Reference::error`]; `NaN` when
+    /// the run failed).
     pub error: f64,
     /// Largest error of the impact times against the reference's
     /// ([`Reference::impact_time_error`]); `None` when the reference has none.

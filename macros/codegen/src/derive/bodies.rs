@@ -30,7 +30,8 @@ use super::Row;
 use crate::ctxt::{suggest, Ctxt};
 use crate::model::expr::{Context, Translator};
 use crate::model::value::{
-    add_v, cross, dot, mat_mat, mat_vec, scale_v, sub_v, time_derivative, FrameValue, Value,
+    add_v, cross, dot, mat_mat, mat_vec, scale_v, sub_v, time_derivative, FrameValue,
+    FrameVelocity, InParent, Value,
 };
 use crate::parse::{Decl, DeclKind};
 use crate::sym::{diff, transform, Deps, ExprId, Func, Graph, Var};
@@ -627,6 +628,7 @@ impl<'a> Builder<'_, 'a> {
                         docs: format!("Euler-parameter normalization θᵀθ − 1 = 0 of `{}`.", d.name),
                         span: d.name.span(),
                         expr: c,
+                        velocity: None,
                     });
                 }
             }
@@ -641,6 +643,54 @@ impl<'a> Builder<'_, 'a> {
                 }
             }
         };
+        let mut exact_rates = pv.exact_rates;
+        let mut omega_in_parent = None;
+        let omega = match (dim, fl.get("rotation"), &pv.omega) {
+            (3, Some(r), Some(w)) => {
+                let (w, wp, exact) = self.relative_rate(r, &rel_rotation, w)?;
+                exact_rates &= exact;
+                omega_in_parent = Some(wp);
+                Some(w)
+            }
+            _ => None,
+        };
+        let velocity = match (&pv.velocity, &pv.omega, &omega, parent) {
+            (Some(_), Some(_), Some(_), None) => {
+                let base = origin
+                    .iter()
+                    .map(|&x| time_derivative(self.g(), x))
+                    .collect();
+                let z = self.g().constant(0.0);
+                Some(FrameVelocity {
+                    base,
+                    relative: vec![z; 3],
+                    in_parent: None,
+                })
+            }
+            (Some(pvel), Some(wp), Some(_), Some(_)) => {
+                let od: Vec<ExprId> = origin
+                    .iter()
+                    .map(|&x| time_derivative(self.g(), x))
+                    .collect();
+                let wo = cross(self.g(), wp, &origin);
+                let s1 = add_v(self.g(), &pvel.relative, &wo);
+                let rp = add_v(self.g(), &s1, &od);
+                let rt = crate::model::value::transpose(3, &rel_rotation);
+                let relative = mat_vec(self.g(), 3, &rt, &rp);
+                Some(FrameVelocity {
+                    base: pvel.base.clone(),
+                    relative,
+                    in_parent: Some(InParent {
+                        velocity: rp,
+                        rotation: pv.rotation.clone(),
+                        omega: wp.clone(),
+                        relative: rel_rotation.clone(),
+                        frame_omega: omega_in_parent.clone().expect("spatial frame"),
+                    }),
+                })
+            }
+            _ => None,
+        };
         let po = mat_vec(self.g(), dim, &pv.rotation, &origin);
         let origin = add_v(self.g(), &pv.origin, &po);
         let rotation = if parent.is_some() {
@@ -653,6 +703,25 @@ impl<'a> Builder<'_, 'a> {
             (Some(a), _) => Some(a),
             _ => None,
         };
+        if dim == 3 && exact_rates {
+            if let Some(w) = &omega {
+                // `Ȧ = A ω̃`: three operations an entry instead of the forward rate of
+                // the product of the rotations down the tree.
+                let g = self.g();
+                let zero = g.constant(0.0);
+                let nw: Vec<ExprId> = w.iter().map(|&x| g.neg(x)).collect();
+                let skew = [zero, nw[2], w[1], w[2], zero, nw[0], nw[1], w[0], zero];
+                let ad = mat_mat(g, 3, &rotation, &skew);
+                // Sums only: a product's forward rate is as short, and other
+                // expressions share product nodes (`cos φ cos θ`) whose own rates
+                // simplify better.
+                for (&e, &r) in rotation.iter().zip(&ad) {
+                    if matches!(g.node(e), crate::sym::Node::Add(_)) {
+                        diff::declare_rate(g, e, r);
+                    }
+                }
+            }
+        }
         let value = FrameValue {
             dim,
             origin,
@@ -666,6 +735,9 @@ impl<'a> Builder<'_, 'a> {
             },
             angle,
             euler,
+            omega,
+            velocity,
+            exact_rates,
         };
         self.tr.frames.push(value.clone());
         self.out.frames.push(FrameOut {
@@ -676,6 +748,114 @@ impl<'a> Builder<'_, 'a> {
             value,
         });
         Some(self.tr.frames.len() - 1)
+    }
+
+    /// The angular velocity in the frame's components of a frame turned by `rotation`
+    /// (the user's expression, translated: `rel`) relative to a parent whose angular
+    /// velocity in its own components is `w`. A product of factors is taken factor by
+    /// factor, `ω̄ ← Fᵀ ω̄ + ω̄_F`, with `ω̄_F` the rate `ȧ e_k` of `rot_x/y/z(a)`, `2Ē θ̇`
+    /// of `euler_parameters`, zero for a constant factor, and the axial vector of `FᵀḞ`
+    /// otherwise (also for a whole rotation that is not a product of 3×3 matrices).
+    /// Also returns the same angular velocity in the parent's components
+    /// (`ω̄_p + Σ_k F_1⋯F_k ω̄_{F_k}`) and whether every factor is a coordinate-axis
+    /// rotation or constant ([`FrameValue::exact_rates`]).
+    fn relative_rate(
+        &mut self,
+        rotation: &syn::Expr,
+        rel: &[ExprId],
+        w: &[ExprId],
+    ) -> Option<(Vec<ExprId>, Vec<ExprId>, bool)> {
+        fn flatten<'e>(e: &'e syn::Expr, out: &mut Vec<&'e syn::Expr>) {
+            match e {
+                syn::Expr::Paren(p) => flatten(&p.expr, out),
+                syn::Expr::Group(p) => flatten(&p.expr, out),
+                syn::Expr::Binary(b) if matches!(b.op, syn::BinOp::Mul(_)) => {
+                    flatten(&b.left, out);
+                    flatten(&b.right, out);
+                }
+                _ => out.push(e),
+            }
+        }
+        let mut list = Vec::new();
+        flatten(rotation, &mut list);
+        let mut factors = Vec::new();
+        for f in &list {
+            match self.tr.field_value(f, Context::Kinematics)? {
+                Value::Matrix(3, m) => factors.push((Some(*f), m)),
+                _ => {
+                    factors = vec![(None, rel.to_vec())];
+                    break;
+                }
+            }
+        }
+        let mut w_parent = w.to_vec();
+        let mut w = w.to_vec();
+        let mut exact = true;
+        let (o, z) = (self.g().constant(1.0), self.g().constant(0.0));
+        let mut prefix = vec![o, z, z, z, o, z, z, z, o];
+        for (e, m) in factors {
+            let (own, elementary) = self.factor_rate(e, &m)?;
+            exact &= elementary;
+            prefix = mat_mat(self.g(), 3, &prefix, &m);
+            let seen = mat_vec(self.g(), 3, &prefix, &own);
+            w_parent = add_v(self.g(), &w_parent, &seen);
+            let mt = crate::model::value::transpose(3, &m);
+            let turned = mat_vec(self.g(), 3, &mt, &w);
+            w = add_v(self.g(), &turned, &own);
+        }
+        Some((w, w_parent, exact))
+    }
+
+    /// `ω̄_F` of one factor `F = m` of a rotation (see [`Self::relative_rate`]).
+    fn factor_rate(&mut self, e: Option<&syn::Expr>, m: &[ExprId]) -> Option<(Vec<ExprId>, bool)> {
+        let zero = self.g().constant(0.0);
+        let moving = m.iter().any(|&x| {
+            let d = self.tr.g.deps(x);
+            d.has(Deps::Q) || d.has(Deps::TIME)
+        });
+        if !moving {
+            return Some((vec![zero; 3], true));
+        }
+        if let Some(syn::Expr::Call(c)) = e {
+            let name = match &*c.func {
+                syn::Expr::Path(p) => p.path.get_ident().map(ToString::to_string),
+                _ => None,
+            };
+            let axis = match name.as_deref() {
+                Some("rot_x") => Some(0),
+                Some("rot_y") => Some(1),
+                Some("rot_z") => Some(2),
+                _ => None,
+            };
+            if let (Some(k), 1) = (axis, c.args.len()) {
+                let a = self.scalar(&c.args[0], Context::Kinematics)?;
+                let r = time_derivative(self.g(), a);
+                let mut out = vec![zero; 3];
+                out[k] = r;
+                return Some((out, true));
+            }
+            if name.as_deref() == Some("euler_parameters") && c.args.len() == 4 {
+                let mut p = Vec::new();
+                for a in &c.args {
+                    p.push(self.scalar(a, Context::Kinematics)?);
+                }
+                let fv = FrameValue {
+                    dim: 3,
+                    origin: Vec::new(),
+                    rotation: Vec::new(),
+                    angle: None,
+                    euler: Some([p[0], p[1], p[2], p[3]]),
+                    omega: None,
+                    velocity: None,
+                    exact_rates: false,
+                };
+                return Some((fv.body_angular_velocity(self.g()), false));
+            }
+        }
+        let md: Vec<ExprId> = m.iter().map(|&x| time_derivative(self.g(), x)).collect();
+        let mt = crate::model::value::transpose(3, m);
+        let x = mat_mat(self.g(), 3, &mt, &md);
+        Some((vec![x[7], x[2], x[3]], false))
     }
 
     fn frame(&mut self, d: &Decl, _: Option<()>) -> Option<()> {
@@ -723,11 +903,59 @@ impl<'a> Builder<'_, 'a> {
         let mass = self.scalar(fl.get("mass")?, Context::Kinematics)?;
         let com = self.at(&fl, "com", dim)?;
         let rc = fv.point(self.g(), &com);
+        let half = self.g().constant(0.5);
+        let mut terms = Vec::new();
+        let split = match (&fv.velocity, &fv.omega) {
+            (Some(vel), Some(w)) => {
+                // `v_c = b + A_e u`: the base in global components, the rest in those of
+                // the parent frame when the centre of mass is the origin (no rotation by
+                // the joint's own angle), else of the body's frame.
+                let com_zero = com.iter().all(|&x| self.tr.g.is_zero(x));
+                let (rot, omega_e, u) = match (&vel.in_parent, com_zero) {
+                    (Some(p), true) => (p.rotation.clone(), p.omega.clone(), p.velocity.clone()),
+                    _ => {
+                        let wc = cross(self.g(), w, &com);
+                        let u = add_v(self.g(), &vel.relative, &wc);
+                        (fv.rotation.clone(), w.clone(), u)
+                    }
+                };
+                Some((vel.base.clone(), rot, omega_e, u))
+            }
+            _ => None,
+        };
         let vc: Vec<ExprId> = rc.iter().map(|&x| time_derivative(self.g(), x)).collect();
         let vv = dot(self.g(), &vc, &vc);
-        let half = self.g().constant(0.5);
-        let mut terms = vec![self.g().mul(vec![half, mass, vv])];
-        self.kane(&vc, &Inertia::Scalar(mass), None);
+        terms.push(self.g().mul(vec![half, mass, vv]));
+        let global = |b: &mut Self| b.kane(&vc, &Inertia::Scalar(mass), None);
+        match split {
+            Some((base, rot, omega_e, u)) => {
+                // Whichever form of the products is smaller for this body.
+                let saved = (self.kane_mass.clone(), self.kane_forces.clone());
+                let added = |b: &Self| -> Vec<ExprId> {
+                    let mut r: Vec<ExprId> = b
+                        .kane_forces
+                        .iter()
+                        .zip(&saved.1)
+                        .flat_map(|(now, before)| now[before.len()..].to_vec())
+                        .collect();
+                    for (k, v) in &b.kane_mass {
+                        let n0 = saved.0.get(k).map_or(0, Vec::len);
+                        r.extend_from_slice(&v[n0..]);
+                    }
+                    r
+                };
+                self.kane_translation(mass, &base, &rot, &omega_e, &u);
+                let split_ops = transform::op_count(self.tr.g, &added(self));
+                (self.kane_mass, self.kane_forces) = saved.clone();
+                global(self);
+                let global_ops = transform::op_count(self.tr.g, &added(self));
+                if split_ops < global_ops {
+                    (self.kane_mass, self.kane_forces) = saved.clone();
+                    self.kane_translation(mass, &base, &rot, &omega_e, &u);
+                }
+            }
+            None => global(self),
+        }
         let mut principal = Vec::new();
         if let Some(ie) = fl.get("inertia") {
             if dim == 2 {
@@ -763,6 +991,30 @@ impl<'a> Builder<'_, 'a> {
                     }
                 }
                 principal.extend([inertia[0], inertia[4], inertia[8]]);
+                // An inertia the joint's rotation leaves unchanged (a wheel spinning on
+                // its axle) is taken in the parent's components, where the spin angle
+                // does not enter: `Ī_p = F Ī Fᵀ`, the rate `F ω̄`, and the gyroscopic
+                // term with the parent's angular velocity, `ω̄_p × Ī_p ω`.
+                let parent_view = fv.velocity.as_ref().and_then(|v| v.in_parent.clone());
+                if let Some(p) = parent_view {
+                    let g = self.g();
+                    let fi = mat_mat(g, 3, &p.relative, &inertia);
+                    let ft = crate::model::value::transpose(3, &p.relative);
+                    let ip = mat_mat(g, 3, &fi, &ft);
+                    let constant = ip.iter().all(|&x| {
+                        let d = g.deps(x);
+                        !d.has(Deps::Q) && !d.has(Deps::TIME)
+                    });
+                    if constant {
+                        let w = p.frame_omega.clone();
+                        let iw = mat_vec(g, 3, &ip, &w);
+                        let wiw = dot(g, &w, &iw);
+                        terms.push(g.mul(vec![half, wiw]));
+                        let gyroscopic = cross(g, &p.omega, &iw);
+                        self.kane(&w, &Inertia::Matrix(ip), Some(&gyroscopic));
+                        return self.finish_body(d, k, mass, rc, principal, terms);
+                    }
+                }
                 let w = fv.body_angular_velocity(self.g());
                 let iw = mat_vec(self.g(), 3, &inertia, &w);
                 let wiw = dot(self.g(), &w, &iw);
@@ -771,6 +1023,19 @@ impl<'a> Builder<'_, 'a> {
                 self.kane(&w, &Inertia::Matrix(inertia.clone()), Some(&gyroscopic));
             }
         }
+        self.finish_body(d, k, mass, rc, principal, terms)
+    }
+
+    /// Records a rigid body's energy, gravity, drawing and output entry.
+    fn finish_body(
+        &mut self,
+        d: &Decl,
+        k: usize,
+        mass: ExprId,
+        rc: Vec<ExprId>,
+        principal: Vec<ExprId>,
+        terms: Vec<ExprId>,
+    ) -> Option<()> {
         let t = self.g().add(terms);
         self.kinetic.push(t);
         self.masses.push((mass, rc));
@@ -786,6 +1051,81 @@ impl<'a> Builder<'_, 'a> {
             mass,
         });
         Some(())
+    }
+
+    /// Kane's method for a centre of mass of mass `m` whose velocity is `b + A u`: the
+    /// base `b` in global components, `u` in those of a frame with rotation `A` and
+    /// angular velocity `ω̄` (its own components). With the partial velocities
+    /// `J_i = ∂b/∂q̇_i`, `U_i = ∂u/∂q̇_i` and `K_i = Aᵀ J_i`, the mass matrix gains
+    /// `m (J_i·J_j + K_i·U_j + U_i·K_j + U_i·U_j)` and the forces
+    /// `−m (J_i·a_b + K_i·a_u + U_i·(Aᵀ a_b + a_u))`, with the accelerations at `q̈ = 0`
+    /// `a_b = ḃ` and `a_u = u̇ + ω̄ × u` (rates of the components). Each product is taken
+    /// in the components its factors are sparse in: a translation `ẋ` of the base has
+    /// `J = e_x`, `K` a row of `A`, and no `U`.
+    fn kane_translation(
+        &mut self,
+        m: ExprId,
+        b: &[ExprId],
+        a: &[ExprId],
+        w: &[ExprId],
+        u: &[ExprId],
+    ) {
+        type Cols = std::collections::BTreeMap<u32, Vec<ExprId>>;
+        let nq = self.tr.nq();
+        let g = &mut *self.tr.g;
+        let zero = g.constant(0.0);
+        let partials = |g: &mut Graph, v: &[ExprId]| {
+            let mut cols = Cols::new();
+            for (c, &x) in v.iter().enumerate() {
+                diff::for_each_partial(g, x, nq, Var::Qd, &mut |_, j, d| {
+                    cols.entry(j).or_insert_with(|| vec![zero; 3])[c] = d;
+                });
+            }
+            cols
+        };
+        let jb = partials(g, b);
+        let ju = partials(g, u);
+        let at = crate::model::value::transpose(3, a);
+        let kb: Cols = jb
+            .iter()
+            .map(|(&j, c)| (j, mat_vec(g, 3, &at, c)))
+            .collect();
+        let ab: Vec<ExprId> = b.iter().map(|&x| time_derivative(g, x)).collect();
+        let ud: Vec<ExprId> = u.iter().map(|&x| time_derivative(g, x)).collect();
+        let wu = cross(g, w, u);
+        let au = add_v(g, &ud, &wu);
+        let abl = mat_vec(g, 3, &at, &ab);
+        let au_total = add_v(g, &abl, &au);
+        let keys: std::collections::BTreeSet<u32> = jb.keys().chain(ju.keys()).copied().collect();
+        let dot_opt = |g: &mut Graph, x: Option<&Vec<ExprId>>, y: &[ExprId]| match x {
+            Some(x) => dot(g, x, y),
+            None => zero,
+        };
+        let dot2 = |g: &mut Graph, x: Option<&Vec<ExprId>>, y: Option<&Vec<ExprId>>| match (x, y) {
+            (Some(x), Some(y)) => dot(g, x, y),
+            _ => zero,
+        };
+        for &i in &keys {
+            let f1 = dot_opt(g, jb.get(&i), &ab);
+            let f2 = dot_opt(g, kb.get(&i), &au);
+            let f3 = dot_opt(g, ju.get(&i), &au_total);
+            let f = g.add(vec![f1, f2, f3]);
+            let mf = g.mul(vec![m, f]);
+            let neg = g.neg(mf);
+            self.kane_forces[i as usize].push(neg);
+            for &j in keys.range(i..) {
+                let t1 = dot2(g, jb.get(&i), jb.get(&j));
+                let t2 = dot2(g, kb.get(&i), ju.get(&j));
+                let t3 = dot2(g, ju.get(&i), kb.get(&j));
+                let t4 = dot2(g, ju.get(&i), ju.get(&j));
+                let s = g.add(vec![t1, t2, t3, t4]);
+                if g.is_canonical() && g.is_zero(s) {
+                    continue;
+                }
+                let mij = g.mul(vec![m, s]);
+                self.kane_mass.entry((i, j)).or_default().push(mij);
+            }
+        }
     }
 
     /// Adds one rigid motion's generalized inertia forces by Kane's method. `u` is a
@@ -922,6 +1262,7 @@ impl<'a> Builder<'_, 'a> {
                 docs: d.docs.clone(),
                 span: d.name.span(),
                 expr: *expr,
+                velocity: None,
             });
         }
         (start, idx(rows.len()))
@@ -1001,6 +1342,7 @@ impl<'a> Builder<'_, 'a> {
             })
         };
         let planar = dim == 2;
+        let mut contact_rate = None;
         let mut h: Vec<(&str, ExprId)> = Vec::new();
         let mut nh: Vec<(&str, ExprId)> = Vec::new();
         let variant: &'static str = match (kind.as_str(), planar) {
@@ -1162,7 +1504,15 @@ impl<'a> Builder<'_, 'a> {
                 let na = dot(self.g(), &up.0, &a);
                 let proj = scale_v(self.g(), na, &a);
                 let w = sub_v(self.g(), &up.0, &proj);
-                let wsq = dot(self.g(), &w, &w);
+                // |w|² = 1 − (n·a)² for unit `n` and `a`; `a` is a unit vector for every
+                // `q` when the frame's rotation is built from axis rotations.
+                let wsq = if fa.exact_rates {
+                    let one = self.g().constant(1.0);
+                    let na2 = self.g().mul(vec![na, na]);
+                    self.g().sub(one, na2)
+                } else {
+                    dot(self.g(), &w, &w)
+                };
                 let wn = self.g().call(Func::Sqrt, wsq);
                 let mr = self.g().neg(radius);
                 let s = self.g().div(mr, wn);
@@ -1180,12 +1530,17 @@ impl<'a> Builder<'_, 'a> {
                         up: up.0.clone(),
                     });
                 }
-                let vc: Vec<ExprId> = c.iter().map(|&x| time_derivative(self.g(), x)).collect();
+                let vc = fa.point_velocity(self.g(), &center);
                 let Value::Vector(omega) = fa.angular_velocity(self.g()) else {
                     unreachable!("spatial frames have a vector rate")
                 };
                 let spin = cross(self.g(), &omega, &down);
                 let vp = add_v(self.g(), &vc, &spin);
+                // The contact height is the lowest of the rim's points, so its rate is
+                // that of the material point there (the envelope theorem): `Ċ = v_p·n`.
+                if fa.exact_rates {
+                    contact_rate = Some(dot(self.g(), &vp, &up.0));
+                }
                 nh.push(("longitudinal", dot(self.g(), &vp, &up.1)));
                 nh.push(("lateral", dot(self.g(), &vp, &up.2)));
                 "RollingWheel"
@@ -1217,6 +1572,9 @@ impl<'a> Builder<'_, 'a> {
             }),
         }
         let hr = self.push_rows(d, h, false);
+        if contact_rate.is_some() {
+            self.out.holonomic[hr.0 as usize].velocity = contact_rate;
+        }
         let nr = self.push_rows(d, nh, true);
         self.out.joints.push(JointOut {
             name: d.name.to_string(),
@@ -1446,6 +1804,7 @@ impl<'a> Builder<'_, 'a> {
                 docs: d.docs.clone(),
                 span: d.name.span(),
                 expr: gap,
+                velocity: None,
             },
             restitution,
             restitution_span: re.span(),

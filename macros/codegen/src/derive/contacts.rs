@@ -74,6 +74,7 @@ pub fn translate(tr: &mut Translator<'_>, model: &Model) -> Vec<Option<ContactRo
                     docs: f.docs.clone(),
                     span: f.name.span(),
                     expr,
+                    velocity: None,
                 },
                 restitution: *e,
                 restitution_span,

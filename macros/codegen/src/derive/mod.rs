@@ -38,6 +38,11 @@ pub struct Row {
     pub docs: String,
     pub span: proc_macro2::Span,
     pub expr: ExprId,
+    /// Holonomic rows: an expression equal to `Ċ = C_q q̇ + C_t` for every `q`, when
+    /// the body level knows one cheaper than the rate of `expr` (a rolling wheel's
+    /// contact: the velocity of the wheel's material point at the contact along the
+    /// normal). `C_q` is then read from it as `∂Ċ/∂q̇` on `∂C/∂q`'s pattern.
+    pub velocity: Option<ExprId>,
 }
 
 /// A structurally non-zero matrix entry.
@@ -199,6 +204,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             docs: f.docs.clone(),
             span: f.name.span(),
             expr,
+            velocity: None,
         })
     };
     let mut holonomic: Vec<Option<Row>> = model
@@ -249,7 +255,6 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     let t_kin = kinetic?;
     let t_lagrange = lagrange_kinetic?;
     let v_pot = potential?;
-    let qv: Vec<ExprId> = (0..n).map(|i| g.var(Var::Qd(idx(i)))).collect();
 
     // Mass matrix and quadratic-velocity forces from T.
     let momenta: Vec<ExprId> = (0..n)
@@ -313,18 +318,39 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             continue;
         }
         let r = c.len();
-        let mut rate_terms = Vec::new();
-        diff::for_each_partial(g, h, n, Var::Q, &mut |g, j, d| {
-            cq.push(Entry {
-                row: idx(r),
-                col: j,
-                expr: d,
-            });
-            rate_terms.push(g.mul(vec![d, qv[j as usize]]));
-        });
-        let h_t = diff::differentiate(g, h, Var::Time);
-        rate_terms.push(h_t);
-        let cdot = g.add(rate_terms);
+        let mut pattern = Vec::new();
+        diff::for_each_partial(g, h, n, Var::Q, &mut |_, j, d| pattern.push((j, d)));
+        let (h_t, cdot) = match row.velocity {
+            Some(v) => {
+                for (j, _) in &mut pattern {
+                    let d = diff::differentiate(g, v, Var::Qd(*j));
+                    cq.push(Entry {
+                        row: idx(r),
+                        col: *j,
+                        expr: d,
+                    });
+                }
+                let h_t = transform::substitute(g, v, &mut |g, v| match v {
+                    Var::Qd(_) => Some(g.constant(0.0)),
+                    _ => None,
+                });
+                (h_t, v)
+            }
+            None => {
+                for (j, d) in pattern {
+                    cq.push(Entry {
+                        row: idx(r),
+                        col: j,
+                        expr: d,
+                    });
+                }
+                // `Ċ = C_q q̇ + C_t` as the forward-mode rate of `C`, not the sum over
+                // the Jacobian's entries: the second rate then walks `C`'s DAG twice
+                // instead of differentiating every entry of `C_q` (ARCHITECTURE.md, "The
+                // body level").
+                (diff::differentiate(g, h, Var::Time), diff::rate(g, h))
+            }
+        };
         let s = diff::rate(g, cdot);
         c.push(h);
         ct.push(h_t);

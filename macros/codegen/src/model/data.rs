@@ -216,18 +216,39 @@ pub fn lower(
             cx.error_spanned_by(get("len")?, "a data slot holds at least one value");
             return None;
         }
-        return Some(DataDecl {
-            name,
-            docs,
-            offset,
-            len,
-            beam: None,
-        });
+        if len > MAX_DATA {
+            cx.error_spanned_by(
+                get("len")?,
+                format!("a data slot holds at most {MAX_DATA} values"),
+            );
+            return None;
+        }
+        return within_total(
+            cx,
+            get("len")?,
+            DataDecl {
+                name,
+                docs,
+                offset,
+                len,
+                beam: None,
+            },
+        );
     }
     let spatial = kind == "SpatialBeam";
     let elements = integer(cx, get("elements")?, "the number of elements")?;
     if elements == 0 {
         cx.error_spanned_by(get("elements")?, "a beam has at least one element");
+        return None;
+    }
+    if elements > MAX_ELEMENTS {
+        cx.error_spanned_by(
+            get("elements")?,
+            format!(
+                "a beam has at most {MAX_ELEMENTS} elements: a finer mesh is a finite element \
+                 program's job, whose invariants a `Data` slot takes"
+            ),
+        );
         return None;
     }
     let (modes, mode_set) = match get("modes")? {
@@ -303,6 +324,16 @@ pub fn lower(
     }
     let d = if spatial { 3 } else { 2 };
     let n = nb + modes;
+    if n > MAX_ELASTIC {
+        cx.error_spanned_by(
+            get("modes")?,
+            format!(
+                "{n} elastic coordinates: a body has at most {MAX_ELASTIC} (modes and boundary \
+                 coordinates together)"
+            ),
+        );
+        return None;
+    }
     let section_names = if spatial {
         SPATIAL_SECTION
     } else {
@@ -324,13 +355,42 @@ pub fn lower(
         d,
         n,
     };
-    Some(DataDecl {
-        name,
-        docs,
-        offset,
-        len: flat_len(d, n) + 2 + beam.ndof() * n + n * n,
-        beam: Some(beam),
-    })
+    let len = flat_len(d, n) + 2 + beam.ndof() * n + n * n;
+    within_total(
+        cx,
+        &s.path,
+        DataDecl {
+            name,
+            docs,
+            offset,
+            len,
+            beam: Some(beam),
+        },
+    )
+}
+
+/// The most values one `Data { len }` slot holds.
+pub const MAX_DATA: usize = 1 << 24;
+/// The most elements one beam assembles.
+pub const MAX_ELEMENTS: usize = 10_000;
+/// The most elastic coordinates one beam body has.
+pub const MAX_ELASTIC: usize = 1_000;
+
+/// Keeps the slot only if every value of the model's run-time data still has a 32-bit
+/// index (the generated code addresses data by `u32`).
+fn within_total<T: quote::ToTokens>(cx: &Ctxt, at: T, d: DataDecl) -> Option<DataDecl> {
+    if d.offset + d.len > u32::MAX as usize {
+        cx.error_spanned_by(
+            at,
+            format!(
+                "the model's run-time data would hold {} values: at most {} fit",
+                d.offset + d.len,
+                u32::MAX
+            ),
+        );
+        return None;
+    }
+    Some(d)
 }
 
 fn integer(cx: &Ctxt, e: &syn::Expr, what: &str) -> Option<usize> {

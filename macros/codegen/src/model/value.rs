@@ -55,6 +55,50 @@ pub struct FrameValue {
     pub angle: Option<ExprId>,
     /// Frames oriented by Euler parameters: the four parameters.
     pub euler: Option<[ExprId; 4]>,
+    /// Spatial frames: the angular velocity in the frame's own components, built down
+    /// the frame tree (`ω̄ = Fᵀ ω̄_before + ω̄_F` for each factor `F` of a relative
+    /// rotation) rather than from the derivative of the composed rotation matrix.
+    pub omega: Option<Vec<ExprId>>,
+    /// Spatial frames: the origin's velocity in two pieces, `v_o = b + A r`. The base
+    /// `b` (global components) is the velocity of the origin of the topmost frame below
+    /// the ground, the rate of its origin expression (`[ẋ, ẏ, ż]` for a body given
+    /// by absolute coordinates); `r` is the rest, in the frame's own components, built
+    /// down the frame tree: `r = Fᵀ (r_p + ω̄_p × o + ȯ)` with `o` the origin in the
+    /// parent's components and `F` the relative rotation. Kane's method dots the pieces
+    /// each in its own components (`derive/bodies.rs`).
+    pub velocity: Option<FrameVelocity>,
+    /// Whether [`Self::omega`] and [`Self::velocity`] are the rates of the rotation and
+    /// the origin for every `q`: every factor of the rotations down the tree is a
+    /// coordinate-axis rotation or constant. With Euler parameters they are so only on
+    /// the normalization's manifold, which is enough for the mass matrix and forces
+    /// but not for a Jacobian read from a velocity.
+    pub exact_rates: bool,
+}
+
+/// The two pieces of a spatial frame's origin velocity (see [`FrameValue::velocity`]).
+#[derive(Clone, Debug)]
+pub struct FrameVelocity {
+    /// `b`, global components.
+    pub base: Vec<ExprId>,
+    /// `r`, in the frame's components.
+    pub relative: Vec<ExprId>,
+    /// The frame seen from its parent; `None` below the ground.
+    pub in_parent: Option<InParent>,
+}
+
+/// A spatial frame's motion in its parent's components (see [`FrameVelocity`]).
+#[derive(Clone, Debug)]
+pub struct InParent {
+    /// `r` before the relative rotation: `r_p + ω̄_p × o + ȯ`.
+    pub velocity: Vec<ExprId>,
+    /// The parent's global rotation.
+    pub rotation: Vec<ExprId>,
+    /// The parent's angular velocity (its components).
+    pub omega: Vec<ExprId>,
+    /// The relative rotation `F` (parent ← frame).
+    pub relative: Vec<ExprId>,
+    /// This frame's angular velocity in the parent's components, `F ω̄`.
+    pub frame_omega: Vec<ExprId>,
 }
 
 /// A closure of the description, `|xi| body`: a function of one material coordinate.
@@ -286,6 +330,26 @@ impl FrameValue {
         add_v(g, &self.origin, &au)
     }
 
+    /// The global velocity of the point with frame coordinates `u`: from the frame
+    /// tree's pieces (`b + A_p r_p` at the origin when the frame has a parent, else
+    /// `b + A (r + ω̄ × u)`) for spatial frames, else the rate of its position.
+    pub fn point_velocity(&self, g: &mut Graph, u: &[ExprId]) -> Vec<ExprId> {
+        if let (Some(vel), Some(w), true) = (&self.velocity, &self.omega, self.exact_rates) {
+            let at_origin = u.iter().all(|&x| g.is_zero(x));
+            let (a, r) = match (&vel.in_parent, at_origin) {
+                (Some(p), true) => (p.rotation.clone(), p.velocity.clone()),
+                _ => {
+                    let wu = cross(g, w, u);
+                    (self.rotation.clone(), add_v(g, &vel.relative, &wu))
+                }
+            };
+            let ar = mat_vec(g, 3, &a, &r);
+            return add_v(g, &vel.base, &ar);
+        }
+        let p = self.point(g, u);
+        p.iter().map(|&x| time_derivative(g, x)).collect()
+    }
+
     /// The global angular velocity: a scalar rate for planar frames, a 3-vector for
     /// spatial ones (`2 E θ̇` for Euler parameters, else the axial vector of `Ȧ Aᵀ`).
     pub fn angular_velocity(&self, g: &mut Graph) -> Value {
@@ -304,6 +368,36 @@ impl FrameValue {
                 .collect();
             return Value::Vector(w);
         }
+        let parent = self.velocity.as_ref().and_then(|v| v.in_parent.as_ref());
+        if let (Some(p), true) = (parent, self.exact_rates) {
+            // In the parent's components the joint's own angle does not enter:
+            // `ω = A_p (F ω̄)`, and its rate `A_p ((F ω̄)˙ + ω̄_p × F ω̄)`.
+            let out = mat_vec(g, 3, &p.rotation, &p.frame_omega);
+            let wd: Vec<ExprId> = p
+                .frame_omega
+                .iter()
+                .map(|&x| time_derivative(g, x))
+                .collect();
+            let turn = cross(g, &p.omega, &p.frame_omega);
+            let local = add_v(g, &wd, &turn);
+            let r = mat_vec(g, 3, &p.rotation, &local);
+            for (&e, &x) in out.iter().zip(&r) {
+                diff::declare_rate(g, e, x);
+            }
+            return Value::Vector(out);
+        }
+        if let Some(w) = &self.omega {
+            let out = mat_vec(g, 3, &self.rotation, w);
+            if self.exact_rates {
+                // `d/dt (A ω̄) = A ω̄̇ + A ω̃ ω̄ = A ω̄̇`.
+                let wd: Vec<ExprId> = w.iter().map(|&x| time_derivative(g, x)).collect();
+                let r = mat_vec(g, 3, &self.rotation, &wd);
+                for (&e, &x) in out.iter().zip(&r) {
+                    diff::declare_rate(g, e, x);
+                }
+            }
+            return Value::Vector(out);
+        }
         let ad: Vec<ExprId> = self
             .rotation
             .iter()
@@ -317,6 +411,9 @@ impl FrameValue {
     /// The angular velocity in frame components (spatial frames): `2 Ē θ̇` for Euler
     /// parameters, else the axial vector of `Aᵀ Ȧ`.
     pub fn body_angular_velocity(&self, g: &mut Graph) -> Vec<ExprId> {
+        if let Some(w) = &self.omega {
+            return w.clone();
+        }
         if let Some(e) = self.euler {
             let ed: Vec<ExprId> = e.iter().map(|&x| time_derivative(g, x)).collect();
             let em = euler_e_bar(e, g);
@@ -840,6 +937,13 @@ impl Translator<'_> {
                     rotation,
                     angle: (dim == 2).then_some(z),
                     euler: None,
+                    omega: (dim == 3).then(|| vec![z; 3]),
+                    velocity: (dim == 3).then(|| FrameVelocity {
+                        base: vec![z; 3],
+                        relative: vec![z; 3],
+                        in_parent: None,
+                    }),
+                    exact_rates: true,
                 }
             }
         }

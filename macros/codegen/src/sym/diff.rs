@@ -113,6 +113,18 @@ pub fn rate(g: &mut Graph, e: ExprId) -> ExprId {
     d
 }
 
+/// Declares `r` the rate of `e` (as [`rate`] would return it, at `q̈ = 0`) when `e` has
+/// none yet: a caller that knows a cheaper expression of the same function (a rotation
+/// matrix's `Ȧ = A ω̃`) gives it, and every later rate through `e` uses it. `r` must
+/// equal the rate for every state, or the derivatives built on it are wrong.
+pub fn declare_rate(g: &mut Graph, e: ExprId, r: ExprId) {
+    let moving = Deps::Q.bits() | Deps::TIME.bits();
+    if g.deps(e).bits() & moving == 0 || matches!(g.node(e), Node::Var(_)) {
+        return;
+    }
+    g.rate_memo.entry(e).or_insert(r);
+}
+
 /// The directional derivative `Σ_i ∂e/∂x_i · w_i` for pairs `(x_i, w_i)`.
 ///
 /// Variables absent from `e` are skipped once `e` is primed for their kind (the first
