@@ -28,6 +28,10 @@ pub struct Run {
     pub stride: u32,
 }
 
+/// The contraction terms of one coefficient and kind of variable: (variable index,
+/// data index, index of the term in the sum).
+type Group = Vec<(u32, u32, usize)>;
+
 /// A term `c · D[d] · x_i` as `(c, velocity?, i, d)`.
 fn contraction_term(g: &Graph, t: ExprId) -> Option<(f64, bool, u32, u32)> {
     let Node::Mul(f) = g.node(t) else {
@@ -56,7 +60,7 @@ pub fn find(g: &Graph, terms: &[ExprId], slots: &[Range<u32>]) -> Option<(Vec<Ru
         return None;
     }
     // Groups by coefficient and kind of variable: (var index, data index, term index).
-    let mut groups: BTreeMap<(u64, bool), Vec<(u32, u32, usize)>> = BTreeMap::new();
+    let mut groups: BTreeMap<(u64, bool), Group> = BTreeMap::new();
     for (k, &t) in terms.iter().enumerate() {
         if let Some((c, vel, i, d)) = contraction_term(g, t) {
             groups
@@ -150,6 +154,11 @@ pub fn find(g: &Graph, terms: &[ExprId], slots: &[Range<u32>]) -> Option<(Vec<Ru
 mod tests {
     use super::*;
 
+    /// One data slot of `len` entries.
+    fn slot(len: u32) -> [Range<u32>; 1] {
+        [Range { start: 0, end: len }]
+    }
+
     /// `Σ_j c D[d0 + s j] x_{i0 + j}` for `j < len`, as terms.
     fn contraction(g: &mut Graph, c: f64, d0: u32, s: u32, i0: u32, len: u32) -> Vec<ExprId> {
         (0..len)
@@ -177,7 +186,7 @@ mod tests {
         let Node::Add(terms) = g.node(sum).clone() else {
             panic!("a sum")
         };
-        let (mut runs, rest) = find(&g, &terms, &[0..1000]).expect("runs");
+        let (mut runs, rest) = find(&g, &terms, &slot(1000)).expect("runs");
         runs.sort_by_key(|r| r.stride);
         let expect = |data, stride| Run {
             coef: 1.0,
@@ -203,7 +212,7 @@ mod tests {
             panic!("a sum")
         };
         assert!(find(&g, &terms, &[0..100, 100..200]).is_none());
-        let (runs, rest) = find(&g, &terms, &[0..200]).expect("one slot");
+        let (runs, rest) = find(&g, &terms, &slot(200)).expect("one slot");
         assert_eq!(runs.len(), 1);
         assert_eq!(runs[0].coef, -1.0);
         assert!(rest.is_empty());
@@ -218,7 +227,7 @@ mod tests {
         let Node::Add(terms) = g.node(sum).clone() else {
             panic!("a sum")
         };
-        assert!(find(&g, &terms, &[0..200]).is_none());
+        assert!(find(&g, &terms, &slot(200)).is_none());
     }
 
     /// The hub beam of `tests/benches/flex_modes.rs` with `n` modes, expanded.
