@@ -245,23 +245,67 @@ mod hub_beam {
     };
 }
 
+/// The beam of `hub_beam` with 16 elements and 12 modes: from 8 modes on, the generated
+/// code contracts the slot's blocks with `q_f`, `q̇_f` in loops (`dot_strided`).
+#[pfaff::mechanism]
+mod hub_beam12 {
+    static rod_fe: Data = Beam {
+        elements: 16,
+        length: 10.0,
+        rho_a: 1.2,
+        ea: 2.8e7,
+        ei: 1.4e4,
+        modes: 12,
+        reference: Clamped,
+    };
+    static theta: Coordinate = Coordinate {};
+    static p1: Coordinate = Coordinate {};
+    static p2: Coordinate = Coordinate {};
+    static p3: Coordinate = Coordinate {};
+    static p4: Coordinate = Coordinate {};
+    static p5: Coordinate = Coordinate {};
+    static p6: Coordinate = Coordinate {};
+    static p7: Coordinate = Coordinate {};
+    static p8: Coordinate = Coordinate {};
+    static p9: Coordinate = Coordinate {};
+    static p10: Coordinate = Coordinate {};
+    static p11: Coordinate = Coordinate {};
+    static p12: Coordinate = Coordinate {};
+    static rod: Body = Deformable {
+        origin: [0.0, 0.0],
+        angle: theta,
+        elastic: [p1, p2, p3, p4, p5, p6, p7, p8, p9, p10, p11, p12],
+        data: rod_fe,
+    };
+}
+
 /// math-spec V6 on a body from beam elements: the generated mass matrix and forces of
 /// `hub_beam` equal E13 and E14 (with `−K_ff q_f`) evaluated from the `pfaff::flex`
 /// invariants, at random states, to 1e-12 relative.
 #[test]
 fn deformable_body_from_a_beam_slot_matches_e13_e14() {
-    let model = hub_beam::Model::default();
+    check_e13_e14(&hub_beam::Model::default(), 8, 4);
+}
+
+/// As [`deformable_body_from_a_beam_slot_matches_e13_e14`] with 12 modes, whose
+/// generated code evaluates the contractions in loops.
+#[test]
+fn deformable_body_of_many_modes_matches_e13_e14() {
+    check_e13_e14(&hub_beam12::Model::default(), 16, 12);
+}
+
+fn check_e13_e14(model: &dyn Mechanism, elements: usize, n: usize) {
     let inv = Beam {
         dim: Dim::Planar,
-        elements: 8,
+        elements,
         length: 10.0,
         section: Section::planar(1.2, 2.8e7, 1.4e4),
         reference: Reference::Clamped { node: 0 },
-        reduction: Reduction::Modes(4),
+        reduction: Reduction::Modes(n),
     }
     .invariants()
     .unwrap();
-    let n = 4;
+    let nq = n + 1;
     let mut seed = 11_u64;
     let mut rnd = || {
         seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
@@ -272,8 +316,8 @@ fn deformable_body_from_a_beam_slot_matches_e13_e14() {
         (0..n).map(|i| dot(&m[i * n..(i + 1) * n], v)).collect()
     };
     for _ in 0..10 {
-        let q: Vec<f64> = (0..5).map(|_| rnd()).collect();
-        let qd: Vec<f64> = (0..5).map(|_| 3.0 * rnd()).collect();
+        let q: Vec<f64> = (0..nq).map(|_| rnd()).collect();
+        let qd: Vec<f64> = (0..nq).map(|_| 3.0 * rnd()).collect();
         let (p, pd, w) = (&q[1..], &qd[1..], qd[0]);
         // E11: U_kl, and E13's blocks.
         let u = |k: usize, l: usize| {
@@ -282,7 +326,7 @@ fn deformable_body_from_a_beam_slot_matches_e13_e14() {
                 + dot(inv.ibar(l, k), p)
                 + dot(p, &mat_vec(inv.sbar(k, l), p))
         };
-        let mut m = [0.0; 25];
+        let mut m = vec![0.0; nq * nq];
         m[0] = u(0, 0) + u(1, 1);
         let s12: Vec<f64> = (0..n * n)
             .map(|i| inv.sbar(0, 1)[i] - inv.sbar(1, 0)[i])
@@ -294,13 +338,13 @@ fn deformable_body_from_a_beam_slot_matches_e13_e14() {
         for j in 0..n {
             let c = inv.ibar(0, 1)[j] - inv.ibar(1, 0)[j] + ps[j];
             m[j + 1] = c;
-            m[(j + 1) * 5] = c;
+            m[(j + 1) * nq] = c;
             for k in 0..n {
-                m[(j + 1) * 5 + k + 1] = inv.m_ff[j * n + k];
+                m[(j + 1) * nq + k + 1] = inv.m_ff[j * n + k];
             }
         }
         // E14 and −K q_f.
-        let mut f = [0.0; 5];
+        let mut f = vec![0.0; nq];
         let i11_22: Vec<f64> = (0..n)
             .map(|j| inv.ibar(0, 0)[j] + inv.ibar(1, 1)[j])
             .collect();
@@ -318,12 +362,12 @@ fn deformable_body_from_a_beam_slot_matches_e13_e14() {
                 + mat_vec(inv.sbar(1, 1), p)[j];
             f[j + 1] = w * w * cent - 2.0 * w * cor[j] - kp[j];
         }
-        let mut mg = [0.0; 25];
+        let mut mg = vec![0.0; nq * nq];
         model.mass_matrix_dense_inplace(0.0, &q, &mut mg);
-        let mut fg = [0.0; 5];
+        let mut fg = vec![0.0; nq];
         model.forces(0.0, &q, &qd, &mut fg);
         let scale_m = m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        for i in 0..25 {
+        for i in 0..nq * nq {
             assert!(
                 (mg[i] - m[i]).abs() < 1e-12 * scale_m,
                 "M[{i}]: {} vs {}",
@@ -332,7 +376,7 @@ fn deformable_body_from_a_beam_slot_matches_e13_e14() {
             );
         }
         let scale_f = f.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        for i in 0..5 {
+        for i in 0..nq {
             assert!(
                 (fg[i] - f[i]).abs() < 1e-11 * scale_f,
                 "Q[{i}]: {} vs {}",

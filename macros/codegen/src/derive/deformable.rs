@@ -57,6 +57,8 @@ struct Invariants {
     i_bar: Vec<ExprId>,
     /// `S̄_kl` (dim × dim × nf × nf).
     s_kl: Vec<ExprId>,
+    /// Read from a data slot: `M_ff q̇_f` is formed block by block ([`mff_times`]).
+    from_data: bool,
 }
 
 /// The shape functions at the placeholder `ξ`.
@@ -416,7 +418,7 @@ impl Builder<'_, '_> {
             self.potential.push(v);
         }
         if let Some(de) = fl.get("damping") {
-            let dmat = if let syn::Expr::Struct(_) = de {
+            let dq = if let syn::Expr::Struct(_) = de {
                 let dl = fields(self.cx, de, DAMPING_KINDS, "damping")?;
                 let z = self.tr.g.constant(0.0);
                 let alpha = match dl.get("mass") {
@@ -434,22 +436,26 @@ impl Builder<'_, '_> {
                     );
                     return None;
                 }
-                let mff = mff(self.tr.g, &inv, dim, nf);
-                (0..nf * nf)
+                let qd: Vec<ExprId> = qf.iter().map(|&i| self.tr.g.var(Var::Qd(i))).collect();
+                let g = &mut *self.tr.g;
+                let mq = mff_times(g, &inv, dim, nf, &qd);
+                let kq = match &kff {
+                    Some(kf) => mat_vec_rect(g, kf, nf, &qd),
+                    None => vec![z; nf],
+                };
+                (0..nf)
                     .map(|i| {
-                        let a = self.tr.g.mul(vec![alpha, mff[i]]);
-                        let b = match &kff {
-                            Some(kf) => self.tr.g.mul(vec![beta, kf[i]]),
-                            None => z,
-                        };
-                        self.tr.g.add(vec![a, b])
+                        let a = g.mul(vec![alpha, mq[i]]);
+                        let b = g.mul(vec![beta, kq[i]]);
+                        g.add(vec![a, b])
                     })
                     .collect()
             } else {
-                self.table_of(de, &[nf, nf], "damping", "elastic × elastic coordinates")?
+                let dmat =
+                    self.table_of(de, &[nf, nf], "damping", "elastic × elastic coordinates")?;
+                let qd: Vec<ExprId> = qf.iter().map(|&i| self.tr.g.var(Var::Qd(i))).collect();
+                mat_vec_rect(self.tr.g, &dmat, nf, &qd)
             };
-            let qd: Vec<ExprId> = qf.iter().map(|&i| self.tr.g.var(Var::Qd(i))).collect();
-            let dq = mat_vec_rect(self.tr.g, &dmat, nf, &qd);
             let zero = self.tr.g.constant(0.0);
             let mut q = vec![zero; self.tr.nq()];
             for (j, &i) in qf.iter().enumerate() {
@@ -540,6 +546,7 @@ impl Builder<'_, '_> {
                 s_bar: l.s_bar,
                 i_bar: l.i_bar,
                 s_kl: l.s_kl,
+                from_data: true,
             });
         }
         let span = fl.span;
@@ -721,6 +728,7 @@ impl Builder<'_, '_> {
             s_bar,
             i_bar,
             s_kl,
+            from_data: false,
         })
     }
 
@@ -761,8 +769,7 @@ impl Builder<'_, '_> {
         let mut terms = Vec::new();
         let rr = dot(g, &rd, &rd);
         terms.push(g.mul(vec![half, inv.m, rr]));
-        let mff = mff(g, inv, dim, nf);
-        let mq = mat_vec_rect(g, &mff, nf, &qd);
+        let mq = mff_times(g, inv, dim, nf, &qd);
         let ff = dot(g, &qd, &mq);
         terms.push(g.mul(vec![half, ff]));
         if dim == 2 {
@@ -1005,13 +1012,31 @@ fn centre(g: &mut Graph, inv: &Invariants, qv: &[ExprId], dim: usize, nf: usize)
     (0..dim).map(|k| g.add(vec![inv.i1[k], sq[k]])).collect()
 }
 
-/// `M_ff = Σ_k S̄_kk`.
-fn mff(g: &mut Graph, inv: &Invariants, dim: usize, nf: usize) -> Vec<ExprId> {
-    (0..nf * nf)
-        .map(|e| {
-            let parts: Vec<ExprId> = (0..dim)
-                .map(|k| inv.s_kl[(k * dim + k) * nf * nf + e])
-                .collect();
+/// `M_ff v` with `M_ff = Σ_k S̄_kk`. For invariants read from a data slot, as
+/// `Σ_k (S̄_kk v)`: a product of each block with `v`, so that each row stays one
+/// contraction per block (emitted as a loop, `sched::runs`) instead of a sum of
+/// `(Σ_k S̄_kk,ij) v_j`.
+fn mff_times(g: &mut Graph, inv: &Invariants, dim: usize, nf: usize, v: &[ExprId]) -> Vec<ExprId> {
+    if !inv.from_data {
+        let m: Vec<ExprId> = (0..nf * nf)
+            .map(|e| {
+                let parts: Vec<ExprId> = (0..dim)
+                    .map(|k| inv.s_kl[(k * dim + k) * nf * nf + e])
+                    .collect();
+                g.add(parts)
+            })
+            .collect();
+        return mat_vec_rect(g, &m, nf, v);
+    }
+    let blocks: Vec<Vec<ExprId>> = (0..dim)
+        .map(|k| {
+            let b = &inv.s_kl[(k * dim + k) * nf * nf..(k * dim + k + 1) * nf * nf];
+            mat_vec_rect(g, b, nf, v)
+        })
+        .collect();
+    (0..nf)
+        .map(|i| {
+            let parts: Vec<ExprId> = blocks.iter().map(|b| b[i]).collect();
             g.add(parts)
         })
         .collect()

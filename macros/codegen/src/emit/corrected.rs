@@ -49,10 +49,25 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
     if d.cq.is_empty() && d.gm.is_empty() {
         return TokenStream::new();
     }
-    let prog = sched::schedule(g, &roots);
-    if !prog.vars.iter().any(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
+    // The schedule of `super::body`: contractions of data slots become loops.
+    let data_slots: Vec<std::ops::Range<u32>> = names
+        .data
+        .iter()
+        .map(|&(_, _, offset, len)| {
+            let at = |x: usize| u32::try_from(x).expect("data size fits u32");
+            at(offset)..at(offset + len)
+        })
+        .collect();
+    let prog = sched::schedule_with(g, &roots, &data_slots);
+    if !prog.reads(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
         return TokenStream::new();
     }
+    let data_reads = prog
+        .vars
+        .iter()
+        .filter(|v| matches!(v, Var::Data(_)))
+        .count();
+    let inline_data = data_reads + prog.lets.len() > MAX_LETS;
     // Which nodes depend on a velocity, from their operands (post-order).
     let mut moving = vec![false; g.len()];
     for id in transform::post_order(g, &roots) {
@@ -69,6 +84,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
         prog: &prog,
         names,
         array: None,
+        inline_data,
     };
     let mut before = TokenStream::new();
     let mut after = TokenStream::new();
@@ -85,6 +101,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
                 after.extend(quote!(let #name = qd[#i];));
             }
             Var::Param(_) => before.extend(quote!(let #name = self.params.#name;)),
+            Var::Data(_) if inline_data => {}
             Var::Data(i) => {
                 let (field, _, k) = names.data_entry(*i);
                 let k = Literal::usize_unsuffixed(k);
@@ -118,6 +135,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
     }
     let t = arg(&prog, "t", |v| *v == Var::Time);
     let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    // Contractions read `qd` as a slice: after the correction, like the loads.
     quote! {
         fn dynamics_terms_corrected(
             &self,

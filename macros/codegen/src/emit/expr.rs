@@ -5,7 +5,8 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::quote;
 
 use crate::sched::Program;
-use crate::sym::{ExprId, Graph, Node};
+use crate::sched::Run;
+use crate::sym::{ExprId, Graph, Node, Var};
 
 /// Binding strength of an emitted expression.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -20,6 +21,8 @@ pub enum Prec {
 pub trait Names {
     fn var(&self, v: crate::sym::Var) -> Ident;
     fn temp(&self, k: usize) -> Ident;
+    /// The field of the data slot holding `Var::Data(i)` and the entry's index in it.
+    fn data_field(&self, i: u32) -> (Ident, usize);
 }
 
 /// Prints expressions of one program.
@@ -30,6 +33,9 @@ pub struct Printer<'a> {
     pub names: &'a dyn Names,
     /// When set, temporary `k` is element `k` of this local array instead of a `let`.
     pub array: Option<Ident>,
+    /// Data entries are read where they are used (`self.data.slot[k]`) instead of
+    /// bound by `let`s (see `emit::body`).
+    pub inline_data: bool,
 }
 
 fn wrap(ts: TokenStream, prec: Prec, need: Prec) -> TokenStream {
@@ -76,11 +82,16 @@ impl Printer<'_> {
         }
         match self.g.node(id) {
             Node::Const(b) => literal(f64::from_bits(*b)),
+            Node::Var(Var::Data(i)) if self.inline_data => {
+                let (field, k) = self.names.data_field(*i);
+                let k = Literal::usize_unsuffixed(k);
+                (quote!(self.data.#field[#k]), Prec::Atom)
+            }
             Node::Var(v) => {
                 let name = self.names.var(*v);
                 (quote!(#name), Prec::Atom)
             }
-            Node::Add(terms) => self.sum(terms),
+            Node::Add(terms) => self.sum(id, terms),
             Node::Mul(factors) => {
                 let (neg, ts, prec) = self.product(factors);
                 if neg {
@@ -146,9 +157,47 @@ impl Printer<'_> {
         (false, ts, p)
     }
 
-    fn sum(&self, terms: &[ExprId]) -> (TokenStream, Prec) {
+    /// A contraction as a signed term: `c · dot_strided(&data[..], stride, &x[..])`.
+    fn run(&self, r: &Run) -> (bool, TokenStream, Prec) {
+        let (field, k0) = self.names.data_field(r.data);
+        let len = r.len as usize;
+        let stride = r.stride as usize;
+        let end = Literal::usize_unsuffixed(k0 + (len - 1) * stride + 1);
+        let (x, i0) = match r.first {
+            Var::Q(i) => (quote!(q), i as usize),
+            Var::Qd(i) => (quote!(qd), i as usize),
+            _ => unreachable!("runs read coordinates or velocities"),
+        };
+        let (k0, i0, i1) = (
+            Literal::usize_unsuffixed(k0),
+            Literal::usize_unsuffixed(i0),
+            Literal::usize_unsuffixed(i0 + len),
+        );
+        let stride = Literal::usize_unsuffixed(stride);
+        let call = quote!(::pfaff::__private::dot_strided(
+            &self.data.#field[#k0..#end], #stride, &#x[#i0..#i1]
+        ));
+        let mag = r.coef.abs();
+        if mag == 1.0 {
+            (r.coef < 0.0, call, Prec::Atom)
+        } else {
+            let (c, _) = literal(mag);
+            (r.coef < 0.0, quote!(#c * #call), Prec::Product)
+        }
+    }
+
+    fn sum(&self, id: ExprId, terms: &[ExprId]) -> (TokenStream, Prec) {
+        let (runs, terms): (&[Run], &[ExprId]) = match self.prog.runs.get(&id) {
+            Some((r, rest)) => (r, rest),
+            None => (&[], terms),
+        };
         let mut parts: Vec<(bool, TokenStream, Prec)> =
             terms.iter().map(|&t| self.signed_term(t)).collect();
+        parts.extend(runs.iter().map(|r| self.run(r)));
+        if parts.len() == 1 && !parts[0].0 {
+            let (_, ts, p) = parts.pop().expect("one part");
+            return (ts, p);
+        }
         // Positive terms first reads better: `a - b` rather than `-b + a`.
         parts.sort_by_key(|p| p.0);
         let mut out = TokenStream::new();

@@ -159,6 +159,10 @@ impl Names for ModelNames {
     fn temp(&self, k: usize) -> Ident {
         format_ident!("{}{}", self.temp_prefix, k)
     }
+    fn data_field(&self, i: u32) -> (Ident, usize) {
+        let (field, _, k) = self.data_entry(i);
+        (field.clone(), k)
+    }
 }
 
 /// The body of a generated function: reads of the variables it uses, its temporaries,
@@ -169,20 +173,40 @@ fn body(
     roots: &[ExprId],
     store: impl Fn(usize, TokenStream) -> TokenStream,
 ) -> (TokenStream, Program) {
-    let prog = sched::schedule(g, roots);
+    // Contractions of data slots with coordinates become loops (`sched::runs`).
+    let slots: Vec<std::ops::Range<u32>> = names
+        .data
+        .iter()
+        .map(|&(_, _, offset, len)| {
+            let at = |x: usize| u32::try_from(x).expect("data size fits u32");
+            at(offset)..at(offset + len)
+        })
+        .collect();
+    let prog = sched::schedule_with(g, roots, &slots);
     // Every `let` opens a debug-info scope nested in the previous one; LLVM's DWARF
     // writer recurses through that chain, and ten thousand of them (a bicycle's
     // linearization Jacobian) overflow the compiler's stack. Long functions keep their
-    // temporaries in one local array instead.
+    // temporaries in one local array instead, and read data entries where they use
+    // them (the invariants of a body of 64 modes are 20,000 entries).
     let array = (prog.lets.len() > MAX_LETS).then(|| Ident::new(&names.temps, Span::call_site()));
+    let data_reads = prog
+        .vars
+        .iter()
+        .filter(|v| matches!(v, Var::Data(_)))
+        .count();
+    let inline_data = data_reads + prog.lets.len() > MAX_LETS;
     let printer = Printer {
         g,
         prog: &prog,
         names,
         array: array.clone(),
+        inline_data,
     };
     let mut out = TokenStream::new();
     for v in &prog.vars {
+        if inline_data && matches!(v, Var::Data(_)) {
+            continue;
+        }
         let name = names.var(*v);
         out.extend(match v {
             Var::Time => quote!(),
@@ -232,7 +256,7 @@ fn body(
 
 /// The argument name for `t`, `q` or `qd`: prefixed with `_` when unused.
 fn arg(prog: &Program, name: &str, used: impl Fn(&Var) -> bool) -> Ident {
-    if prog.vars.iter().any(used) {
+    if prog.reads(used) {
         Ident::new(name, Span::call_site())
     } else {
         format_ident!("_{}", name)

@@ -5,10 +5,24 @@
 //! and the roots. Only nodes used more than once (by other live nodes or as several
 //! outputs) get a temporary; everything else is inlined at its single use. Temporaries
 //! are numbered in schedule order, so the same input always gives the same program.
+//!
+//! **Contractions.** With run-time data slots ([`schedule_with`]), a sum whose terms
+//! include `c · D[d₀ + k s] · x_{i₀ + k}` for `k = 0 … L−1` (`L ≥` [`MIN_RUN`]: one data
+//! slot read with a constant stride against consecutive coordinates or velocities, the
+//! shape of every product of an invariant matrix of a deformable body with `q_f` or
+//! `q̇_f`) keeps those terms as one [`Run`], which the emitter prints as a loop over the
+//! slices. The absorbed products are not scheduled, so neither they nor the data
+//! entries they read become statements: the code of a body of `n` modes grows like `n`
+//! per contraction instead of `n²` overall.
 
-use std::collections::BTreeSet;
+mod runs;
 
-use crate::sym::{transform, ExprId, Graph, Node, Var};
+use std::collections::{BTreeSet, HashMap};
+use std::ops::Range;
+
+use crate::sym::{ExprId, Graph, Node, Var};
+
+pub use runs::{Run, MIN_RUN};
 
 /// Straight-line code for one function.
 #[derive(Debug)]
@@ -21,6 +35,10 @@ pub struct Program {
     pub temp_of: Vec<Option<usize>>,
     /// The outputs.
     pub roots: Vec<ExprId>,
+    /// Sums with contractions: the runs and the terms left to print one by one.
+    pub runs: HashMap<ExprId, (Vec<Run>, Vec<ExprId>)>,
+    /// The first coordinate or velocity of each run (what the runs read of `q`, `q̇`).
+    pub run_vars: BTreeSet<Var>,
 }
 
 impl Program {
@@ -28,11 +46,55 @@ impl Program {
     pub fn temp(&self, id: ExprId) -> Option<usize> {
         self.temp_of.get(id.index()).copied().flatten()
     }
+
+    /// Whether the program reads a variable for which `pred` holds (as a leaf or
+    /// through a run).
+    pub fn reads(&self, pred: impl Fn(&Var) -> bool) -> bool {
+        self.vars.iter().chain(&self.run_vars).any(pred)
+    }
 }
 
 /// Schedules `roots` into straight-line code.
 pub fn schedule(g: &Graph, roots: &[ExprId]) -> Program {
-    let order = transform::post_order(g, roots);
+    schedule_with(g, roots, &[])
+}
+
+/// Schedules `roots`, keeping contractions over the data `slots` (ranges of
+/// `Var::Data` indices, one per slot) as runs.
+pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Program {
+    let mut runs = HashMap::new();
+    // Post-order of the live nodes; a sum with runs has only its remaining terms as
+    // operands.
+    let mut seen = vec![false; g.len()];
+    let mut order = Vec::new();
+    let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
+    while let Some((id, expanded)) = stack.pop() {
+        if expanded {
+            order.push(id);
+            continue;
+        }
+        if seen[id.index()] {
+            continue;
+        }
+        seen[id.index()] = true;
+        stack.push((id, true));
+        let kids = match g.node(id) {
+            Node::Add(terms) if !slots.is_empty() => match runs::find(g, terms, slots) {
+                Some((r, rest)) => {
+                    let kids = rest.clone();
+                    runs.insert(id, (r, rest));
+                    kids
+                }
+                None => terms.to_vec(),
+            },
+            node => node.args(),
+        };
+        for a in kids.into_iter().rev() {
+            if !seen[a.index()] {
+                stack.push((a, false));
+            }
+        }
+    }
     let mut uses = vec![0u32; g.len()];
     let mut vars = BTreeSet::new();
     for &id in &order {
@@ -41,7 +103,11 @@ pub fn schedule(g: &Graph, roots: &[ExprId]) -> Program {
                 vars.insert(*v);
             }
             node => {
-                for a in node.args() {
+                let kids = match runs.get(&id) {
+                    Some((_, rest)) => rest.clone(),
+                    None => node.args(),
+                };
+                for a in kids {
                     uses[a.index()] += 1;
                 }
             }
@@ -59,10 +125,16 @@ pub fn schedule(g: &Graph, roots: &[ExprId]) -> Program {
             lets.push(id);
         }
     }
+    let run_vars = runs
+        .values()
+        .flat_map(|(r, _)| r.iter().map(|r| r.first))
+        .collect();
     Program {
         vars,
         lets,
         temp_of,
         roots: roots.to_vec(),
+        runs,
+        run_vars,
     }
 }
