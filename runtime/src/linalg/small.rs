@@ -145,11 +145,17 @@ impl SmallLu {
 
 /// $A = L L^\mathsf{T}$ of a symmetric positive definite `n × n` matrix (the lower
 /// triangle is read).
+///
+/// The factor is kept twice, $L$ in the lower triangle and $L^\mathsf{T}$ in the upper
+/// one, with the reciprocals of its diagonal: both substitutions of a solve then run
+/// along contiguous rows and multiply instead of dividing.
 #[derive(Clone, Debug)]
 pub(crate) struct SmallCholesky {
     n: usize,
     a: Vec<f64>,
     scale: Vec<f64>,
+    /// $1 / l_{kk}$.
+    inverse: Vec<f64>,
 }
 
 impl SmallCholesky {
@@ -158,12 +164,23 @@ impl SmallCholesky {
             n,
             a: vec![0.0; n * n],
             scale: vec![1.0; n],
+            inverse: vec![1.0; n],
         }
     }
 
     /// The matrix to factor, row-major (its lower triangle is used); overwritten by $L$.
     pub fn matrix_mut(&mut self) -> &mut [f64] {
-        &mut self.a
+        &mut self.a[..self.n * self.n]
+    }
+
+    /// Makes it the factorization of an `n × n` matrix, `n` at most the size it was
+    /// created with (no allocation).
+    pub fn resize(&mut self, n: usize) {
+        assert!(
+            n <= self.scale.len(),
+            "SmallCholesky::resize beyond its capacity"
+        );
+        self.n = n;
     }
 
     /// Factors in place; returns the magnitudes of the pivots of the equivalent $LU$,
@@ -171,18 +188,31 @@ impl SmallCholesky {
     /// minimum of 0).
     pub fn factor(&mut self) -> Pivots {
         let n = self.n;
-        let a = &mut self.a;
-        for (i, s) in self.scale.iter_mut().enumerate() {
+        if n == 0 {
+            return Pivots { max: 1.0, min: 1.0 };
+        }
+        let a = &mut self.a[..n * n];
+        let scale = &mut self.scale[..n];
+        for (i, s) in scale.iter_mut().enumerate() {
             *s = power_of_two_inverse(a[i * n + i].abs().sqrt());
         }
-        for i in 0..n {
-            for j in 0..=i {
-                a[i * n + j] *= self.scale[i] * self.scale[j];
+        for (i, row) in a.chunks_exact_mut(n).enumerate() {
+            let si = scale[i];
+            for (x, sj) in row[..=i].iter_mut().zip(&scale[..=i]) {
+                *x *= si * sj;
             }
         }
         let (mut max, mut min) = (0.0_f64, f64::INFINITY);
-        for j in 0..n {
-            let d = a[j * n + j] - a[j * n..j * n + j].iter().map(|x| x * x).sum::<f64>();
+        // Row by row (the left-looking form): row i of L from the rows above it.
+        for i in 0..n {
+            let (done, rest) = a.split_at_mut(i * n);
+            let row = &mut rest[..n];
+            for j in 0..i {
+                let lj = &done[j * n..j * n + j];
+                let s: f64 = row[..j].iter().zip(lj).map(|(x, y)| x * y).sum();
+                row[j] = (row[j] - s) * self.inverse[j];
+            }
+            let d = row[i] - row[..i].iter().map(|x| x * x).sum::<f64>();
             if d.is_nan() || d <= 0.0 {
                 return Pivots {
                     max: max.max(d.abs()),
@@ -192,15 +222,14 @@ impl SmallCholesky {
             max = max.max(d);
             min = min.min(d);
             let l = d.sqrt();
-            a[j * n + j] = l;
-            let inv = 1.0 / l;
-            for i in j + 1..n {
-                let s: f64 = (0..j).map(|k| a[i * n + k] * a[j * n + k]).sum();
-                a[i * n + j] = (a[i * n + j] - s) * inv;
-            }
+            row[i] = l;
+            self.inverse[i] = 1.0 / l;
         }
-        if n == 0 {
-            return Pivots { max: 1.0, min: 1.0 };
+        // Lᵀ into the upper triangle, for the backward substitution.
+        for i in 0..n {
+            for j in i + 1..n {
+                a[i * n + j] = a[j * n + i];
+            }
         }
         Pivots { max, min }
     }
@@ -208,25 +237,73 @@ impl SmallCholesky {
     /// Solves $A x = b$ in place with the last factorization.
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.n;
-        let a = &self.a;
+        let a = &self.a[..n * n];
+        let b = &mut b[..n];
+        let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
         // D A D (D⁻¹ x) = D b.
-        for (x, s) in b.iter_mut().zip(&self.scale) {
+        for (x, s) in b.iter_mut().zip(scale) {
             *x *= s;
         }
-        for i in 0..n {
-            let s: f64 = a[i * n..i * n + i]
-                .iter()
-                .zip(&b[..i])
-                .map(|(l, x)| l * x)
-                .sum();
-            b[i] = (b[i] - s) / a[i * n + i];
+        // Column by column (L y = b with the columns of L, the rows of Lᵀ, then
+        // Lᵀ x = y with the columns of Lᵀ, the rows of L): the updates of one column
+        // are independent, so the chain of dependent operations is n long, not n².
+        for j in 0..n {
+            let (head, tail) = b.split_at_mut(j + 1);
+            let bj = head[j] * inverse[j];
+            head[j] = bj;
+            for (x, u) in tail.iter_mut().zip(&a[j * n + j + 1..(j + 1) * n]) {
+                *x -= u * bj;
+            }
         }
         for i in (0..n).rev() {
-            let s: f64 = (i + 1..n).map(|k| a[k * n + i] * b[k]).sum();
-            b[i] = (b[i] - s) / a[i * n + i];
+            let (head, tail) = b.split_at_mut(i);
+            let bi = tail[0] * inverse[i];
+            tail[0] = bi;
+            for (x, l) in head.iter_mut().zip(&a[i * n..i * n + i]) {
+                *x -= l * bi;
+            }
         }
-        for (x, s) in b.iter_mut().zip(&self.scale) {
+        for (x, s) in b.iter_mut().zip(scale) {
             *x *= s;
+        }
+    }
+
+    /// Solves $A X = B$ in place for the `k` columns of `x` (`n × k`, row-major) with
+    /// the last factorization: the substitutions run along the rows of `x`, so the
+    /// columns are solved side by side.
+    pub fn solve_rows(&self, x: &mut [f64], k: usize) {
+        let n = self.n;
+        let a = &self.a[..n * n];
+        let x = &mut x[..n * k];
+        let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
+        if k == 0 {
+            return;
+        }
+        for (row, s) in x.chunks_exact_mut(k).zip(scale) {
+            row.iter_mut().for_each(|v| *v *= s);
+        }
+        for j in 0..n {
+            let (head, tail) = x.split_at_mut((j + 1) * k);
+            let xj = &mut head[j * k..];
+            xj.iter_mut().for_each(|v| *v *= inverse[j]);
+            for (row, u) in tail.chunks_exact_mut(k).zip(&a[j * n + j + 1..(j + 1) * n]) {
+                for (v, w) in row.iter_mut().zip(&*xj) {
+                    *v -= u * w;
+                }
+            }
+        }
+        for i in (0..n).rev() {
+            let (head, tail) = x.split_at_mut(i * k);
+            let xi = &mut tail[..k];
+            xi.iter_mut().for_each(|v| *v *= inverse[i]);
+            for (row, l) in head.chunks_exact_mut(k).zip(&a[i * n..i * n + i]) {
+                for (v, w) in row.iter_mut().zip(&*xi) {
+                    *v -= l * w;
+                }
+            }
+        }
+        for (row, s) in x.chunks_exact_mut(k).zip(scale) {
+            row.iter_mut().for_each(|v| *v *= s);
         }
     }
 }
@@ -298,6 +375,17 @@ mod tests {
                 residual(&x, &s) < tol * n as f64 * n as f64,
                 "Cholesky n = {n}"
             );
+            // Three columns side by side: b, 2b, −b.
+            let mut xs: Vec<f64> = b.iter().flat_map(|&v| [v, 2.0 * v, -v]).collect();
+            ch.solve_rows(&mut xs, 3);
+            for (i, xi) in x.iter().enumerate() {
+                for (c, f) in [1.0, 2.0, -1.0].into_iter().enumerate() {
+                    assert!(
+                        (xs[3 * i + c] - f * xi).abs() <= 8.0 * f64::EPSILON * xi.abs().max(1.0),
+                        "Cholesky columns n = {n}"
+                    );
+                }
+            }
         }
     }
 

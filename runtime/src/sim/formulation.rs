@@ -14,7 +14,7 @@
 //! | [`Stabilized`] | $y$ as it is | as they are | none |
 //! | [`Free`] | $y$ as it is | as they are | none |
 
-use super::chart::{Chart, ChartFailure};
+use super::chart::{Chart, ChartFailure, KAPPA};
 use super::error::{SimErrorKind, SingularMatrix};
 use super::point::{Point, REFIT_RATIO, SINGULAR_RATIO};
 use super::Formulation;
@@ -153,7 +153,7 @@ impl Form for Partitioned {
         self.accepted.copy_from_slice(&p.q);
         self.t_accepted = t;
         self.speed_accepted = inf_norm(&p.qd);
-        if p.rows_h == 0 {
+        if p.rows.is_empty() {
             return Ok(());
         }
         p.factorizations += 1;
@@ -180,7 +180,7 @@ impl Form for Partitioned {
     }
 
     /// The point of the chart: Newton on the normal coordinates from `y`, then the
-    /// orthogonal projection of the velocities.
+    /// velocities along the same normals (see [`Chart`]).
     fn reconstruct<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -227,7 +227,11 @@ impl Form for Partitioned {
                 });
             }
         }
-        p.project_velocities(t)?;
+        match self.chart.correct_velocities(p, t, KAPPA) {
+            Ok(Some(_)) => {}
+            Ok(None) => p.project_velocities(t)?,
+            Err(e) => return Err(SimErrorKind::from_eval(e)),
+        }
         self.cached = Some(t);
         self.y_cached.copy_from_slice(y);
         Ok(())
@@ -241,9 +245,7 @@ impl Form for Partitioned {
         p.accelerations(t, None)
     }
 
-    /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
-    /// Newton, then the velocities): below the integrator's tolerance, so the
-    /// derivatives the integrator keeps stay valid.
+    /// The chart's point, for [`keep`](Form::keep) to polish.
     /// A kept state the chart's chord iteration cannot correct (an output point far
     /// inside a long step of Radau5's dense output, where the anchor's normals no
     /// longer contract) is left to [`keep`](Form::keep)'s full Newton projection from
@@ -265,13 +267,22 @@ impl Form for Partitioned {
         }
     }
 
+    /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
+    /// Newton, then the velocities by the chart's chord iteration to round-off, the
+    /// same orthogonal projection): below the integrator's tolerance, so the
+    /// derivatives the integrator keeps stay valid.
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
         self.cached = None;
-        p.project(t)
+        p.project_positions(t)?;
+        match self.chart.correct_velocities(p, t, 0.0) {
+            Ok(Some(_)) => Ok(()),
+            Ok(None) => p.project_velocities(t),
+            Err(e) => Err(SimErrorKind::from_eval(e)),
+        }
     }
 
     fn recoverable(&self, e: &SimErrorKind) -> bool {

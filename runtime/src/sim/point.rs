@@ -91,8 +91,9 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
     pub lambda: Vec<f64>,
-    /// $[C_q\dot q + C_t;\ G\dot q + g]$.
-    vel: Vec<f64>,
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$ (see
+    /// [`velocity_residuals`](Self::velocity_residuals)).
+    pub vel: Vec<f64>,
     mu: Vec<f64>,
     lu_h: SmallCholesky,
     lu_v: SmallCholesky,
@@ -263,8 +264,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(self.ws.jacobian())
     }
 
-    /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel`.
-    fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
+    /// functions evaluated once per $(t, q)$, the products with $\dot q$ every call).
+    pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
         let info = self.info;
         let mh = info.nh();
         self.jacobian_values(t)?;
@@ -399,6 +401,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$, then
     /// [`project_velocities`](Self::project_velocities).
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        self.project_positions(t)?;
+        self.project_velocities(t)
+    }
+
+    /// The positions' part of [`project`](Self::project).
+    pub fn project_positions(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let n = self.info.nq();
         let eval = SimErrorKind::from_eval;
         let tol = self.newton.tolerance;
@@ -462,7 +470,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 self.factorizations += 1;
             }
         }
-        self.project_velocities(t)
+        Ok(())
     }
 
     /// The orthogonal projection of the velocities onto the velocity constraints at the
