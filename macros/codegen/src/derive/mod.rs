@@ -535,7 +535,44 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     if model.linearize && checking {
         derived.linear = Some(linear::derive(g, &derived, n));
     }
+    if checking {
+        share_right_hand_side(g, &mut derived);
+    }
     Some(derived)
+}
+
+/// Shares the common pairs of product factors (`sym::share`) between the functions one
+/// right-hand side evaluates: `M`, the forces, `C_q`, `γ_h`, `G` and `γ_nh`. Last, after
+/// every derivative (the linearization's included) has been taken from the canonical
+/// nodes.
+fn share_right_hand_side(g: &mut Graph, d: &mut Derived) {
+    let mut roots: Vec<ExprId> = Vec::new();
+    roots.extend(d.mass.iter().map(|e| e.expr));
+    roots.extend(&d.forces);
+    roots.extend(d.cq.iter().map(|e| e.expr));
+    roots.extend(&d.gamma_h);
+    roots.extend(d.gm.iter().map(|e| e.expr));
+    roots.extend(&d.gamma_nh);
+    crate::sym::share::share_products(g, &mut roots);
+    let mut it = roots.into_iter();
+    for e in &mut d.mass {
+        e.expr = it.next().expect("as many roots");
+    }
+    for x in &mut d.forces {
+        *x = it.next().expect("as many roots");
+    }
+    for e in &mut d.cq {
+        e.expr = it.next().expect("as many roots");
+    }
+    for x in &mut d.gamma_h {
+        *x = it.next().expect("as many roots");
+    }
+    for e in &mut d.gm {
+        e.expr = it.next().expect("as many roots");
+    }
+    for x in &mut d.gamma_nh {
+        *x = it.next().expect("as many roots");
+    }
 }
 
 /// The sum of two mass matrices given as row-major entry lists (structural zeros left out).

@@ -305,6 +305,13 @@ impl Graph {
         self.as_const(id) == Some(0.0)
     }
 
+    /// Interns `node` exactly as given, without simplification (operands must exist).
+    /// Only for passes over finished expressions (`share`): a canonical graph's
+    /// constructors assume canonical operands.
+    pub(crate) fn intern_as_is(&mut self, node: Node) -> ExprId {
+        self.intern(node)
+    }
+
     fn intern(&mut self, node: Node) -> ExprId {
         if let Some(&id) = self.lookup.get(&node) {
             return id;

@@ -1,12 +1,13 @@
 //! The symbolic engine: a hash-consed expression DAG ([`graph`]), the table of
 //! operations ([`op`]), memoised differentiation ([`diff`]), numeric evaluation,
-//! substitution and the simplification pass ([`transform`]), and an infix printer
-//! ([`display`]).
+//! substitution and the simplification pass ([`transform`]), the sharing of partial
+//! products in finished expressions ([`share`]), and an infix printer ([`display`]).
 
 pub mod diff;
 pub mod display;
 pub mod graph;
 pub mod op;
+pub mod share;
 pub mod transform;
 
 pub use graph::{Deps, ExprId, Graph, Node, Var};
