@@ -535,7 +535,10 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     if model.linearize && checking {
         derived.linear = Some(linear::derive(g, &derived, n));
     }
-    if checking {
+    // Not with run-time data: the scheduler finds the runs it emits as loops
+    // (`sched/runs.rs`) in the canonical products of data leaves, which the regrouping
+    // would break up.
+    if checking && derived.data.is_empty() {
         share_right_hand_side(g, &mut derived);
     }
     Some(derived)
