@@ -504,6 +504,29 @@ pub trait Mechanism {
         self.nonholonomic_gamma(t, q, qd, out.nonholonomic_gamma);
     }
 
+    /// [`dynamics_terms`](Self::dynamics_terms) with the velocities corrected in
+    /// between: writes `C_q` and `G` at `(t, q)`, calls `correct(cq, g, qd)` (which may
+    /// change `qd`), then writes `M`, `Q`, `γ_h` and `γ_nh` at the corrected `qd`.
+    /// Coordinate partitioning projects the velocities onto the constraints at the
+    /// point with `C_q` and `G` this way, so that the generated code computes what the
+    /// two parts share (the sines of the same angles) once. The default evaluates the
+    /// Jacobians, calls `correct`, then [`dynamics_terms`](Self::dynamics_terms).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
+    fn dynamics_terms_corrected(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+        out: DynamicsTerms<'_>,
+        correct: &mut dyn FnMut(&[f64], &[f64], &mut [f64]),
+    ) {
+        self.holonomic_jacobian(t, q, out.holonomic_jacobian);
+        self.nonholonomic_matrix(t, q, out.nonholonomic_matrix);
+        correct(out.holonomic_jacobian, out.nonholonomic_matrix, qd);
+        self.dynamics_terms(t, q, qd, out);
+    }
+
     /// Solves the augmented system
     /// $[M\ J^\mathsf{T}; J\ 0][\ddot q; \lambda] = [Q; \gamma]$,
     /// $J = [C_q; G]$, in place: `x` holds $[Q; \gamma]$ (length `n + m_h + m_nh`) on

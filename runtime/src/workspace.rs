@@ -510,6 +510,48 @@ impl Workspace {
                 nonholonomic_gamma: gamma_nh,
             },
         );
+        self.check_dynamics_terms(t)
+    }
+
+    /// [`eval_dynamics_terms`](Self::eval_dynamics_terms) through
+    /// [`Mechanism::dynamics_terms_corrected`]: `correct(cq, g, ct, bias, qd)` may change
+    /// `qd` between the position terms and the velocity terms; the rates $C_t$, $g$ it
+    /// reads must have been evaluated at `(t, q)` ([`eval_rates`](Self::eval_rates)).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
+    pub fn eval_dynamics_terms_corrected<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+    ) -> Result<(), EvalError> {
+        self.check_model(mech, q, Some(qd))?;
+        let mh = self.info.nh();
+        let (gamma_h, gamma_nh) = self.gamma.split_at_mut(mh);
+        let (ct, bias) = (&self.ct, &self.bias);
+        mech.dynamics_terms_corrected(
+            t,
+            q,
+            qd,
+            crate::DynamicsTerms {
+                mass: &mut self.mass_values,
+                forces: &mut self.forces,
+                holonomic_jacobian: &mut self.cq_values,
+                holonomic_gamma: gamma_h,
+                nonholonomic_matrix: &mut self.g_values,
+                nonholonomic_gamma: gamma_nh,
+            },
+            &mut |cq, g, qd| correct(cq, g, ct, bias, qd),
+        );
+        self.check_dynamics_terms(t)
+    }
+
+    /// The finiteness checks of the dynamics terms.
+    fn check_dynamics_terms(&self, t: f64) -> Result<(), EvalError> {
+        let info = self.info;
+        let mh = info.nh();
         check_finite_pattern(
             Quantity::MassMatrix,
             t,

@@ -43,7 +43,7 @@ use super::point::{Point, REFIT_RATIO};
 use crate::linalg::inf_norm;
 use crate::linalg::small::{gram_cholesky, SmallCholesky};
 use crate::workspace::EvalError;
-use crate::Mechanism;
+use crate::{Info, Mechanism};
 
 /// Fraction of the integrator's tolerance the Newton iteration leaves as error.
 ///
@@ -101,6 +101,8 @@ pub(crate) struct Chart {
     slot: Vec<usize>,
     /// $G_a^{-1}$ times the velocity residuals.
     nu: Vec<f64>,
+    /// The velocity residuals of every constraint row.
+    vel: Vec<f64>,
     /// The residuals of the current update.
     mu: Vec<f64>,
     /// The current update.
@@ -174,6 +176,7 @@ impl Chart {
             velocity_map_regular: false,
             slot: vec![usize::MAX; m],
             nu: vec![0.0; m],
+            vel: vec![0.0; m],
             mu: vec![0.0; m],
             dx: vec![0.0; n],
             rows: Vec::with_capacity(m),
@@ -320,91 +323,120 @@ impl Chart {
         )
     }
 
-    /// $\dot q \leftarrow \dot q - J^\mathsf{T}G_a^{-1}\mu$ with the pattern values of $J$
-    /// at the point (`mu`: the velocity residuals of `rows`); returns the largest change
-    /// and the largest in the integrator's weights.
-    fn update_velocities<M: Mechanism + ?Sized>(&mut self, p: &mut Point<'_, M>) -> (f64, f64) {
-        let m = self.rows.len();
-        let mu = &self.mu[..m];
-        for (nu, row) in self.nu.iter_mut().zip(self.velocity_map.chunks_exact(m)) {
-            *nu = row.iter().zip(mu).map(|(a, b)| a * b).sum();
-        }
-        let dx = &mut self.dx;
-        dx.fill(0.0);
-        let (info, ws) = (p.info, &p.ws);
-        for (&(r, c), v) in info.holonomic_pattern.iter().zip(&ws.cq_values) {
-            if let Some(nu) = self.nu.get(self.slot[r as usize]) {
-                dx[c as usize] += v * nu;
-            }
-        }
-        let mh = info.nh();
-        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(&ws.g_values) {
-            if let Some(nu) = self.nu.get(self.slot[mh + r as usize]) {
-                dx[c as usize] += v * nu;
-            }
-        }
-        let (mut step, mut weighted) = (0.0_f64, 0.0_f64);
-        for (xj, d) in p.qd.iter_mut().zip(&*dx) {
-            *xj -= d;
-            step = step.max(d.abs());
-            weighted = weighted.max(d.abs() / (self.atol + self.rtol * xj.abs()));
-        }
-        (step, weighted)
-    }
-
     /// Projects the velocities of `p` orthogonally onto the velocity constraints at its
     /// positions by the chord iteration of the module docs, until the estimated
     /// remaining error is below `kappa` in the integrator's weights or at round-off;
     /// returns the number of updates, or `None` when the iteration does not contract
-    /// (or the anchor's rows are singular) and the velocities are to be projected at
-    /// the point instead.
+    /// (or the maps do not serve the point's rows, see [`serves`](Self::serves)) and the
+    /// velocities are to be projected at the point instead.
     pub fn correct_velocities<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
         t: f64,
         kappa: f64,
     ) -> Result<Option<usize>, EvalError> {
-        let m = self.rows.len();
-        if m == 0 && p.rows.is_empty() {
-            return Ok(Some(0));
-        }
-        // Rows renewed since the anchor (`Point::refit`), or rows the maps do not serve;
-        // and redundant constraints: the kept rows imply the dropped ones only while
-        // they keep their rank, which the factored projection checks at the point
-        // (renewing them when it falls), and the maps at the anchor cannot.
-        if !self.velocity_map_regular
-            || self.rows != p.rows
-            || self.rows_h != p.rows_h
-            || p.rows_h != p.info.nh()
-        {
+        if !self.serves(p) {
             return Ok(None);
         }
-        let distance =
-            p.q.iter()
-                .zip(&self.anchor)
-                .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        p.velocity_residuals(t)?;
+        let ws = &p.ws;
+        let terms = VelocityTerms {
+            cq: &ws.cq_values,
+            g: &ws.g_values,
+            ct: &ws.ct,
+            bias: &ws.bias,
+        };
+        let distance = self.distance(&p.q);
+        Ok(self.project_velocities(p.info, terms, distance, &mut p.qd, kappa))
+    }
+
+    /// Whether the velocity iteration serves the rows of `p`: the maps are regular and
+    /// made for its rows, and no redundant constraint was dropped (the kept rows imply
+    /// the dropped ones only while they keep their rank, which the factored projection
+    /// checks at the point, renewing them when it falls, and maps made at the anchor
+    /// cannot).
+    pub fn serves<M: Mechanism + ?Sized>(&self, p: &Point<'_, M>) -> bool {
+        self.velocity_map_regular
+            && self.rows == p.rows
+            && self.rows_h == p.rows_h
+            && p.rows_h == p.info.nh()
+    }
+
+    /// The distance $\lVert q - q_a\rVert_\infty$ of positions `q` from the anchor.
+    pub fn distance(&self, q: &[f64]) -> f64 {
+        q.iter()
+            .zip(&self.anchor)
+            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()))
+    }
+
+    /// The iteration of [`correct_velocities`](Self::correct_velocities) on `qd` at
+    /// positions `distance` from the anchor, with the pattern values of $C_q$, $G$ and
+    /// $C_t$, $g$ there.
+    pub fn project_velocities(
+        &mut self,
+        info: &Info,
+        terms: VelocityTerms<'_>,
+        distance: f64,
+        qd: &mut [f64],
+        kappa: f64,
+    ) -> Option<usize> {
+        let m = self.rows.len();
+        if m == 0 {
+            return Some(0);
+        }
         let mut rate = self
             .velocity_rate_per_distance
             .or(self.rate_per_distance)
             .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
+        let mh = info.nh();
         let mut previous: Option<f64> = None;
         for iteration in 0..MAX_ITERATIONS {
-            p.velocity_residuals(t)?;
-            for (mu, &i) in self.mu.iter_mut().zip(&self.rows) {
-                *mu = p.vel[i];
+            // The residuals J q̇ + [C_t; g] of the rows.
+            self.vel[..mh].copy_from_slice(terms.ct);
+            self.vel[mh..].copy_from_slice(terms.bias);
+            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
+                self.vel[r as usize] += v * qd[c as usize];
             }
-            let floor = 8.0 * f64::EPSILON * inf_norm(&p.qd);
-            let (step, weighted) = self.update_velocities(p);
+            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
+                self.vel[mh + r as usize] += v * qd[c as usize];
+            }
+            for (mu, &i) in self.mu.iter_mut().zip(&self.rows) {
+                *mu = self.vel[i];
+            }
+            // ν = G_a⁻¹ μ, Δq̇ = Jᵀν.
+            let mu = &self.mu[..m];
+            for (nu, row) in self.nu.iter_mut().zip(self.velocity_map.chunks_exact(m)) {
+                *nu = row.iter().zip(mu).map(|(a, b)| a * b).sum();
+            }
+            let dx = &mut self.dx;
+            dx.fill(0.0);
+            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
+                if let Some(nu) = self.nu.get(self.slot[r as usize]) {
+                    dx[c as usize] += v * nu;
+                }
+            }
+            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
+                if let Some(nu) = self.nu.get(self.slot[mh + r as usize]) {
+                    dx[c as usize] += v * nu;
+                }
+            }
+            let floor = 8.0 * f64::EPSILON * inf_norm(qd);
+            let (mut step, mut weighted) = (0.0_f64, 0.0_f64);
+            for (xj, d) in qd.iter_mut().zip(&*dx) {
+                *xj -= d;
+                step = step.max(d.abs());
+                weighted = weighted.max(d.abs() / (self.atol + self.rtol * xj.abs()));
+            }
             if step <= floor {
-                return Ok(Some(iteration + 1));
+                return Some(iteration + 1);
             }
             if !step.is_finite() {
-                return Ok(None);
+                return None;
             }
             if let Some(p) = previous {
                 let measured = weighted / p;
                 if measured.is_nan() || measured >= DIVERGENCE {
-                    return Ok(None);
+                    return None;
                 }
                 rate = measured;
                 if step > 100.0 * floor && distance > 0.0 {
@@ -413,10 +445,20 @@ impl Chart {
             }
             let left = rate / (1.0 - rate);
             if left * weighted <= kappa || left * step <= floor {
-                return Ok(Some(iteration + 1));
+                return Some(iteration + 1);
             }
             previous = Some(weighted);
         }
-        Ok(None)
+        None
     }
+}
+
+/// The pattern values of $C_q$ and $G$ and the rates $C_t$, $g$ at a point, for the
+/// velocity iteration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct VelocityTerms<'a> {
+    pub cq: &'a [f64],
+    pub g: &'a [f64],
+    pub ct: &'a [f64],
+    pub bias: &'a [f64],
 }

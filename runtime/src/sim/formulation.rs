@@ -14,7 +14,7 @@
 //! | [`Stabilized`] | $y$ as it is | as they are | none |
 //! | [`Free`] | $y$ as it is | as they are | none |
 
-use super::chart::{Chart, ChartFailure, KAPPA};
+use super::chart::{Chart, ChartFailure, VelocityTerms, KAPPA};
 use super::error::{SimErrorKind, SingularMatrix};
 use super::point::{Point, REFIT_RATIO, SINGULAR_RATIO};
 use super::Formulation;
@@ -125,6 +125,9 @@ pub(crate) struct Partitioned {
     /// costs nothing.
     cached: Option<f64>,
     y_cached: Vec<f64>,
+    /// Whether the velocities of the point are still to be projected (with the
+    /// dynamics terms, in [`Form::accelerations`]).
+    pending: bool,
 }
 
 impl Partitioned {
@@ -137,6 +140,7 @@ impl Partitioned {
             fit_ratio: 0.0,
             cached: None,
             y_cached: vec![0.0; 2 * n],
+            pending: false,
         }
     }
 }
@@ -179,8 +183,10 @@ impl Form for Partitioned {
         Ok(())
     }
 
-    /// The point of the chart: Newton on the normal coordinates from `y`, then the
-    /// velocities along the same normals (see [`Chart`]).
+    /// The point of the chart: Newton on the normal coordinates from `y`; its
+    /// velocities are projected with the dynamics terms in
+    /// [`accelerations`](Form::accelerations) (by the factored projection here when
+    /// the chart's iteration does not serve the point, see [`Chart::serves`]).
     fn reconstruct<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -227,21 +233,41 @@ impl Form for Partitioned {
                 });
             }
         }
-        match self.chart.correct_velocities(p, t, KAPPA) {
-            Ok(Some(_)) => {}
-            Ok(None) => p.project_velocities(t)?,
-            Err(e) => return Err(SimErrorKind::from_eval(e)),
+        // The velocities: with the dynamics terms when the chart's iteration serves the
+        // point (see `accelerations`), here otherwise.
+        self.pending = self.chart.serves(p);
+        if !self.pending {
+            p.project_velocities(t)?;
         }
         self.cached = Some(t);
         self.y_cached.copy_from_slice(y);
         Ok(())
     }
 
+    /// With the velocities of the chart's point, when [`reconstruct`](Form::reconstruct)
+    /// left them: projected by the chart's iteration inside one call of the fused
+    /// evaluation ([`Point::dynamics_terms_corrected`]), so that $C_q$ and $G$ at the
+    /// point come with $M$, $Q$ and $\gamma$.
     fn accelerations<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
+        if self.pending {
+            self.pending = false;
+            let (info, distance) = (p.info, self.chart.distance(&p.q));
+            let chart = &mut self.chart;
+            let mut outcome = None;
+            p.dynamics_terms_corrected(t, &mut |cq, g, ct, bias, qd| {
+                let terms = VelocityTerms { cq, g, ct, bias };
+                outcome = chart.project_velocities(info, terms, distance, qd, KAPPA);
+            })
+            .map_err(SimErrorKind::from_eval)?;
+            if outcome.is_none() {
+                // Not contracting: the factored projection, and the terms again.
+                p.project_velocities(t)?;
+            }
+        }
         p.accelerations(t, None)
     }
 
@@ -277,6 +303,7 @@ impl Form for Partitioned {
         t: f64,
     ) -> Result<(), SimErrorKind> {
         self.cached = None;
+        self.pending = false;
         p.project_positions(t)?;
         match self.chart.correct_velocities(p, t, 0.0) {
             Ok(Some(_)) => Ok(()),

@@ -342,6 +342,30 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
+    /// The velocities corrected by `correct(cq, g, ct, bias, qd)` with the pattern values
+    /// of $C_q$, $G$ and the rates at the current $(t, q)$, then $M$, $Q$ and $\gamma$ at
+    /// the corrected velocities, from one call of the model's fused evaluation
+    /// ([`Mechanism::dynamics_terms_corrected`]).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
+    pub fn dynamics_terms_corrected(
+        &mut self,
+        t: f64,
+        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+    ) -> Result<(), EvalError> {
+        if !self.rates.check(t, &self.q, &[]) {
+            self.ws.eval_rates(self.mech, t, &self.q)?;
+            self.rates.set(t, &self.q, &[]);
+        }
+        self.jacobian.valid = false;
+        self.terms.valid = false;
+        self.ws
+            .eval_dynamics_terms_corrected(self.mech, t, &self.q, &mut self.qd, correct)?;
+        self.terms.set(t, &self.q, &self.qd);
+        self.jacobian.set(t, &self.q, &[]);
+        Ok(())
+    }
+
     /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
     /// $\lambda = 0$.
     pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {

@@ -253,3 +253,108 @@ fn every_built_in_model_agrees_with_the_dense_path() {
         eprintln!("{}: generated on {n} of 20", entry.name);
     }
 }
+
+/// The terms of one `dynamics_terms` call at `(q, qd)`, concatenated in the order of
+/// [`DynamicsTerms`]' fields.
+fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut forces = vec![0.0; n];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut gh = vec![0.0; mh];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut gnh = vec![0.0; mnh];
+    model.dynamics_terms(
+        t,
+        q,
+        qd,
+        DynamicsTerms {
+            mass: &mut mass,
+            forces: &mut forces,
+            holonomic_jacobian: &mut cq,
+            holonomic_gamma: &mut gh,
+            nonholonomic_matrix: &mut g,
+            nonholonomic_gamma: &mut gnh,
+        },
+    );
+    [mass, forces, cq, gh, g, gnh].concat()
+}
+
+/// `dynamics_terms_corrected` (generated for models with constraint rows, the trait's
+/// default otherwise) hands the correction `C_q` and `G` at `q` (equal to
+/// `holonomic_jacobian` and `nonholonomic_matrix`) and writes every term at the
+/// velocities as the correction left them: equal to `dynamics_terms` there, on seeded
+/// random states of models with angles, lengths, driven coordinates (slider_crank),
+/// non-holonomic rows (sleigh, rolling_disk, bicycle) and run-time data
+/// (flexible_crank).
+#[test]
+fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
+    for (name, seed) in [
+        ("pendulum", 21),
+        ("andrews", 22),
+        ("car_axis", 23),
+        ("slider_crank", 24),
+        ("sleigh", 25),
+        ("rolling_disk", 26),
+        ("bicycle", 27),
+        ("flexible_crank", 28),
+        ("spatial_four_bar", 29),
+    ] {
+        let model = (pfaff_models::find(name).expect("a built-in model").make)();
+        let info = model.info();
+        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        for (k, (q, qd)) in states(model.as_ref(), 5, seed).into_iter().enumerate() {
+            #[allow(clippy::cast_precision_loss)]
+            let t = 0.1 * k as f64;
+            let mut cq = vec![0.0; info.holonomic_pattern.len()];
+            let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+            model.holonomic_jacobian(t, &q, &mut cq);
+            model.nonholonomic_matrix(t, &q, &mut g);
+            let mut out = vec![0.0; info.mass_pattern.len()];
+            let mut forces = vec![0.0; n];
+            let mut cq_out = vec![0.0; cq.len()];
+            let mut gh = vec![0.0; mh];
+            let mut g_out = vec![0.0; g.len()];
+            let mut gnh = vec![0.0; mnh];
+            let mut corrected = qd.clone();
+            let mut seen = None;
+            model.dynamics_terms_corrected(
+                t,
+                &q,
+                &mut corrected,
+                DynamicsTerms {
+                    mass: &mut out,
+                    forces: &mut forces,
+                    holonomic_jacobian: &mut cq_out,
+                    holonomic_gamma: &mut gh,
+                    nonholonomic_matrix: &mut g_out,
+                    nonholonomic_gamma: &mut gnh,
+                },
+                &mut |c, gm, v| {
+                    seen = Some((c.to_vec(), gm.to_vec()));
+                    // Any change of the velocities: a shear of them.
+                    for (j, x) in v.iter_mut().enumerate() {
+                        #[allow(clippy::cast_precision_loss)]
+                        let s = 0.3 + 0.1 * j as f64;
+                        *x = s * *x + 0.05;
+                    }
+                },
+            );
+            let (c, gm) = seen.expect("the correction is called");
+            // The fused schedule shares other subexpressions than the separate
+            // functions: equal up to rounding.
+            assert!(relative(&c, &cq, 1.0) <= 1e-14, "{name}: C_q handed over");
+            assert!(relative(&gm, &g, 1.0) <= 1e-14, "{name}: G handed over");
+            assert_ne!(corrected, qd, "{name}: the velocities were changed");
+            let expected = terms(model.as_ref(), t, &q, &corrected);
+            let got = [out, forces, cq_out, gh, g_out, gnh].concat();
+            let scale = expected.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+            let e = relative(&got, &expected, scale);
+            assert!(
+                e <= 1e-14,
+                "{name}: terms at the corrected velocities off by {e:e}"
+            );
+        }
+    }
+}

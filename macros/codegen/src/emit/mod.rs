@@ -6,6 +6,7 @@
 //! (the trait's default fills zeros). Runtime paths go through `::pfaff::__private`.
 
 mod contacts;
+mod corrected;
 mod data;
 pub mod expr;
 pub mod solve;
@@ -400,6 +401,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         fns.extend(vector_fn(g, &names, "outputs", &roots, true));
     }
     fns.extend(dynamics_terms(g, &names, d));
+    fns.extend(corrected::dynamics_terms_corrected(g, &names, d));
     fns.extend(solve::augmented_solve(
         g,
         model.coords.len(),

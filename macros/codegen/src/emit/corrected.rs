@@ -1,0 +1,153 @@
+//! `Mechanism::dynamics_terms_corrected`: the fused dynamics terms with the
+//! velocities corrected between the position terms and the velocity terms.
+//!
+//! Input: the roots of `dynamics_terms` (`M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh`). Output: one
+//! function whose body is the schedule of `dynamics_terms` split in two: the loads of
+//! `t`, `q`, the parameters and data, every temporary and output that does not depend on
+//! a velocity (so `C_q` and `G`, and the sines and cosines of the angles), then a call
+//! of the runtime's correction with `C_q` and `G` (which may change `q̇`), then the loads
+//! of `q̇` and everything that depends on it. Coordinate partitioning projects the
+//! velocities onto the constraints at the corrected positions with `C_q` and `G` and
+//! needs `M`, `Q` and `γ` at the projected velocities: in one call, what the two share
+//! is computed once (on `andrews`, the sines and cosines of `holonomic_jacobian`).
+//! Every temporary is still computed once; the split only orders them (a temporary that
+//! does not depend on `q̇` never depends on one that does).
+
+use proc_macro2::{Literal, Span, TokenStream};
+use quote::quote;
+use syn::Ident;
+
+use super::expr::{Names, Printer};
+use super::{arg, entries, ModelNames, MAX_LETS};
+use crate::derive::Derived;
+use crate::sched;
+use crate::sym::{transform, Graph, Node, Var};
+
+/// The trait method, or nothing (the trait's default, which evaluates `C_q` and `G`
+/// on their own, then `dynamics_terms`) when the model has no constraint rows, when no
+/// output depends on a velocity, or when `dynamics_terms` has more than [`MAX_LETS`]
+/// temporaries: the function repeats `dynamics_terms`, and for the largest models
+/// (long chains, many elastic modes) compiling it twice costs more than the shared
+/// sines save.
+pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
+    let parts: [(&str, Vec<_>); 6] = [
+        ("mass", entries(&d.mass)),
+        ("forces", d.forces.clone()),
+        ("holonomic_jacobian", entries(&d.cq)),
+        ("holonomic_gamma", d.gamma_h.clone()),
+        ("nonholonomic_matrix", entries(&d.gm)),
+        ("nonholonomic_gamma", d.gamma_nh.clone()),
+    ];
+    let mut roots = Vec::new();
+    let mut slots = Vec::new();
+    for (field, ids) in &parts {
+        for (k, &id) in ids.iter().enumerate() {
+            roots.push(id);
+            slots.push((Ident::new(field, Span::call_site()), k));
+        }
+    }
+    if d.cq.is_empty() && d.gm.is_empty() {
+        return TokenStream::new();
+    }
+    // The schedule of `super::body`: contractions of data slots become loops.
+    let data_slots: Vec<std::ops::Range<u32>> = names
+        .data
+        .iter()
+        .map(|&(_, _, offset, len)| {
+            let at = |x: usize| u32::try_from(x).expect("data size fits u32");
+            at(offset)..at(offset + len)
+        })
+        .collect();
+    let prog = sched::schedule_with(g, &roots, &data_slots);
+    if !prog.reads(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
+        return TokenStream::new();
+    }
+    let data_reads = prog
+        .vars
+        .iter()
+        .filter(|v| matches!(v, Var::Data(_)))
+        .count();
+    let inline_data = data_reads + prog.lets.len() > MAX_LETS;
+    // Which nodes depend on a velocity, from their operands (post-order).
+    let mut moving = vec![false; g.len()];
+    for id in transform::post_order(g, &roots) {
+        moving[id.index()] = match g.node(id) {
+            Node::Var(v) => matches!(v, Var::Qd(_)),
+            Node::Const(_) => false,
+            node => node.args().into_iter().any(|a| moving[a.index()]),
+        };
+    }
+
+    // At most MAX_LETS temporaries: each is a `let` (see `super::body`).
+    let printer = Printer {
+        g,
+        prog: &prog,
+        names,
+        array: None,
+        inline_data,
+    };
+    let mut before = TokenStream::new();
+    let mut after = TokenStream::new();
+    for v in &prog.vars {
+        let name = names.var(*v);
+        match v {
+            Var::Time => {}
+            Var::Q(i) => {
+                let i = Literal::u32_unsuffixed(*i);
+                before.extend(quote!(let #name = q[#i];));
+            }
+            Var::Qd(i) => {
+                let i = Literal::u32_unsuffixed(*i);
+                after.extend(quote!(let #name = qd[#i];));
+            }
+            Var::Param(_) => before.extend(quote!(let #name = self.params.#name;)),
+            Var::Data(_) if inline_data => {}
+            Var::Data(i) => {
+                let (field, _, k) = names.data_entry(*i);
+                let k = Literal::usize_unsuffixed(k);
+                before.extend(quote!(let #name = self.data.#field[#k];));
+            }
+            Var::Delta(_) | Var::Input(_) => {
+                unreachable!("the dynamics terms read no variations or inputs")
+            }
+        }
+    }
+    for (k, &id) in prog.lets.iter().enumerate() {
+        let (ts, _) = printer.expr(id, true);
+        let name = names.temp(k);
+        let stmt = quote!(let #name = #ts;);
+        if moving[id.index()] {
+            after.extend(stmt);
+        } else {
+            before.extend(stmt);
+        }
+    }
+    for (k, &r) in roots.iter().enumerate() {
+        let (ts, _) = printer.expr(r, false);
+        let (field, i) = &slots[k];
+        let i = Literal::usize_unsuffixed(*i);
+        let stmt = quote!(out.#field[#i] = #ts;);
+        if moving[r.index()] {
+            after.extend(stmt);
+        } else {
+            before.extend(stmt);
+        }
+    }
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    // Contractions read `qd` as a slice: after the correction, like the loads.
+    quote! {
+        fn dynamics_terms_corrected(
+            &self,
+            #t: f64,
+            #q: &[f64],
+            qd: &mut [f64],
+            out: ::pfaff::__private::DynamicsTerms<'_>,
+            correct: &mut dyn ::core::ops::FnMut(&[f64], &[f64], &mut [f64]),
+        ) {
+            #before
+            correct(out.holonomic_jacobian, out.nonholonomic_matrix, qd);
+            #after
+        }
+    }
+}
