@@ -13,12 +13,11 @@
 //! Every temporary is still computed once; the split only orders them (a temporary that
 //! does not depend on `q̇` never depends on one that does).
 
-use proc_macro2::{Literal, Span, TokenStream};
+use proc_macro2::{Literal, TokenStream};
 use quote::quote;
-use syn::Ident;
 
 use super::expr::{Names, Printer};
-use super::{arg, entries, ModelNames, MAX_LETS};
+use super::{arg, data_slots, dynamics_roots, ModelNames, MAX_LETS};
 use crate::derive::Derived;
 use crate::sched;
 use crate::sym::{transform, Graph, Node, Var};
@@ -30,35 +29,12 @@ use crate::sym::{transform, Graph, Node, Var};
 /// (long chains, many elastic modes) compiling it twice costs more than the shared
 /// sines save.
 pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
-    let parts: [(&str, Vec<_>); 6] = [
-        ("mass", entries(&d.mass)),
-        ("forces", d.forces.clone()),
-        ("holonomic_jacobian", entries(&d.cq)),
-        ("holonomic_gamma", d.gamma_h.clone()),
-        ("nonholonomic_matrix", entries(&d.gm)),
-        ("nonholonomic_gamma", d.gamma_nh.clone()),
-    ];
-    let mut roots = Vec::new();
-    let mut slots = Vec::new();
-    for (field, ids) in &parts {
-        for (k, &id) in ids.iter().enumerate() {
-            roots.push(id);
-            slots.push((Ident::new(field, Span::call_site()), k));
-        }
-    }
+    let (roots, slots) = dynamics_roots(d);
     if d.cq.is_empty() && d.gm.is_empty() {
         return TokenStream::new();
     }
     // The schedule of `super::body`: contractions of data slots become loops.
-    let data_slots: Vec<std::ops::Range<u32>> = names
-        .data
-        .iter()
-        .map(|&(_, _, offset, len)| {
-            let at = |x: usize| u32::try_from(x).expect("data size fits u32");
-            at(offset)..at(offset + len)
-        })
-        .collect();
-    let prog = sched::schedule_with(g, &roots, &data_slots);
+    let prog = sched::schedule_with(g, &roots, &data_slots(names));
     if !prog.reads(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
         return TokenStream::new();
     }

@@ -165,6 +165,40 @@ impl Names for ModelNames {
     }
 }
 
+/// The ranges of `Var::Data` indices of the model's data slots, whose contractions with
+/// coordinates the schedule keeps as loops (`sched::runs`). The description bounds the
+/// data to 32-bit indices (`model::data`).
+fn data_slots(names: &ModelNames) -> Vec<std::ops::Range<u32>> {
+    let at = |x: usize| u32::try_from(x).expect("the description bounds data to u32 indices");
+    names
+        .data
+        .iter()
+        .map(|&(_, _, offset, len)| at(offset)..at(offset + len))
+        .collect()
+}
+
+/// The outputs of `dynamics_terms` in its order, as roots of one schedule and the
+/// `(field, index)` of `DynamicsTerms` each root is stored in.
+fn dynamics_roots(d: &Derived) -> (Vec<ExprId>, Vec<(Ident, usize)>) {
+    let parts: [(&str, Vec<ExprId>); 6] = [
+        ("mass", entries(&d.mass)),
+        ("forces", d.forces.clone()),
+        ("holonomic_jacobian", entries(&d.cq)),
+        ("holonomic_gamma", d.gamma_h.clone()),
+        ("nonholonomic_matrix", entries(&d.gm)),
+        ("nonholonomic_gamma", d.gamma_nh.clone()),
+    ];
+    let mut roots = Vec::new();
+    let mut slots = Vec::new();
+    for (field, ids) in &parts {
+        for (k, &id) in ids.iter().enumerate() {
+            roots.push(id);
+            slots.push((Ident::new(field, Span::call_site()), k));
+        }
+    }
+    (roots, slots)
+}
+
 /// The body of a generated function: reads of the variables it uses, its temporaries,
 /// and a final statement per output produced by `store`.
 fn body(
@@ -173,16 +207,7 @@ fn body(
     roots: &[ExprId],
     store: impl Fn(usize, TokenStream) -> TokenStream,
 ) -> (TokenStream, Program) {
-    // Contractions of data slots with coordinates become loops (`sched::runs`).
-    let slots: Vec<std::ops::Range<u32>> = names
-        .data
-        .iter()
-        .map(|&(_, _, offset, len)| {
-            let at = |x: usize| u32::try_from(x).expect("data size fits u32");
-            at(offset)..at(offset + len)
-        })
-        .collect();
-    let prog = sched::schedule_with(g, roots, &slots);
+    let prog = sched::schedule_with(g, roots, &data_slots(names));
     // Every `let` opens a debug-info scope nested in the previous one; LLVM's DWARF
     // writer recurses through that chain, and ten thousand of them (a bicycle's
     // linearization Jacobian) overflow the compiler's stack. Long functions keep their
@@ -864,22 +889,7 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
 /// `dynamics_terms`: `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh` in one schedule, so that what
 /// they share is computed once.
 fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
-    let parts: [(&str, Vec<ExprId>); 6] = [
-        ("mass", entries(&d.mass)),
-        ("forces", d.forces.clone()),
-        ("holonomic_jacobian", entries(&d.cq)),
-        ("holonomic_gamma", d.gamma_h.clone()),
-        ("nonholonomic_matrix", entries(&d.gm)),
-        ("nonholonomic_gamma", d.gamma_nh.clone()),
-    ];
-    let mut roots = Vec::new();
-    let mut slots = Vec::new();
-    for (field, ids) in &parts {
-        for (k, &id) in ids.iter().enumerate() {
-            roots.push(id);
-            slots.push((Ident::new(field, Span::call_site()), k));
-        }
-    }
+    let (roots, slots) = dynamics_roots(d);
     let (code, prog) = body(g, names, &roots, |k, ts| {
         let (field, i) = &slots[k];
         let i = Literal::usize_unsuffixed(*i);
