@@ -2,6 +2,7 @@
 //! free body (math-spec V12), and every joint type against finite differences.
 
 mod bricard;
+mod chain;
 mod drawing;
 mod joints;
 mod masses;
