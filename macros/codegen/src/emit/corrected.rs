@@ -17,10 +17,10 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::expr::{Names, Printer};
-use super::{arg, data_slots, dynamics_roots, ModelNames, MAX_LETS};
+use super::{arg, data_slots, dynamics_roots, reads_data_inline, ModelNames, MAX_LETS};
 use crate::derive::Derived;
 use crate::sched;
-use crate::sym::{transform, Graph, Node, Var};
+use crate::sym::{Deps, ExprId, Graph, Var};
 
 /// The trait method, or nothing (the trait's default, which evaluates `C_q` and `G`
 /// on their own, then `dynamics_terms`) when the model has no constraint rows, when no
@@ -29,30 +29,18 @@ use crate::sym::{transform, Graph, Node, Var};
 /// (long chains, many elastic modes) compiling it twice costs more than the shared
 /// sines save.
 pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
-    let (roots, slots) = dynamics_roots(d);
     if d.cq.is_empty() && d.gm.is_empty() {
         return TokenStream::new();
     }
+    let (roots, slots) = dynamics_roots(d);
     // The schedule of `super::body`: contractions of data slots become loops.
     let prog = sched::schedule_with(g, &roots, &data_slots(names));
     if !prog.reads(|v| matches!(v, Var::Qd(_))) || prog.lets.len() > MAX_LETS {
         return TokenStream::new();
     }
-    let data_reads = prog
-        .vars
-        .iter()
-        .filter(|v| matches!(v, Var::Data(_)))
-        .count();
-    let inline_data = data_reads + prog.lets.len() > MAX_LETS;
-    // Which nodes depend on a velocity, from their operands (post-order).
-    let mut moving = vec![false; g.len()];
-    for id in transform::post_order(g, &roots) {
-        moving[id.index()] = match g.node(id) {
-            Node::Var(v) => matches!(v, Var::Qd(_)),
-            Node::Const(_) => false,
-            node => node.args().into_iter().any(|a| moving[a.index()]),
-        };
-    }
+    let inline_data = reads_data_inline(&prog);
+    // Which nodes depend on a velocity: the graph's dependency summary of each node.
+    let moving = |id: ExprId| g.deps(id).has(Deps::QD);
 
     // At most MAX_LETS temporaries: each is a `let` (see `super::body`).
     let printer = Printer {
@@ -92,7 +80,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
         let (ts, _) = printer.expr(id, true);
         let name = names.temp(k);
         let stmt = quote!(let #name = #ts;);
-        if moving[id.index()] {
+        if moving(id) {
             after.extend(stmt);
         } else {
             before.extend(stmt);
@@ -103,7 +91,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
         let (field, i) = &slots[k];
         let i = Literal::usize_unsuffixed(*i);
         let stmt = quote!(out.#field[#i] = #ts;);
-        if moving[r.index()] {
+        if moving(r) {
             after.extend(stmt);
         } else {
             before.extend(stmt);

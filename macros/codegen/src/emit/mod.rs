@@ -177,6 +177,17 @@ fn data_slots(names: &ModelNames) -> Vec<std::ops::Range<u32>> {
         .collect()
 }
 
+/// Whether a function reads its data entries where it uses them rather than binding
+/// each to a `let`: when the bindings and the temporaries together pass [`MAX_LETS`].
+fn reads_data_inline(prog: &Program) -> bool {
+    let data_reads = prog
+        .vars
+        .iter()
+        .filter(|v| matches!(v, Var::Data(_)))
+        .count();
+    data_reads + prog.lets.len() > MAX_LETS
+}
+
 /// The outputs of `dynamics_terms` in its order, as roots of one schedule and the
 /// `(field, index)` of `DynamicsTerms` each root is stored in.
 fn dynamics_roots(d: &Derived) -> (Vec<ExprId>, Vec<(Ident, usize)>) {
@@ -214,12 +225,7 @@ fn body(
     // temporaries in one local array instead, and read data entries where they use
     // them (the invariants of a body of 64 modes are 20,000 entries).
     let array = (prog.lets.len() > MAX_LETS).then(|| Ident::new(&names.temps, Span::call_site()));
-    let data_reads = prog
-        .vars
-        .iter()
-        .filter(|v| matches!(v, Var::Data(_)))
-        .count();
-    let inline_data = data_reads + prog.lets.len() > MAX_LETS;
+    let inline_data = reads_data_inline(&prog);
     let printer = Printer {
         g,
         prog: &prog,
