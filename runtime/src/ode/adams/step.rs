@@ -16,7 +16,7 @@
 use super::super::common::{eval, is_recoverable, RECOVER_FACTOR, UROUND};
 use super::super::error::OdeError;
 use super::super::system::OdeSystem;
-use super::Adams;
+use super::{Adams, Coeffs};
 
 /// $\gamma^\ast_1..\gamma^\ast_{13}$ of `ode.f` (math-spec §9.1), 1-based.
 const GSTR: [f64; 14] = [
@@ -40,6 +40,67 @@ struct Estimates {
     erk: f64,
     erkm1: f64,
     knew: usize,
+}
+
+/// $1/i$ (index 0 unused), the values `STEP` divides out.
+const INV: [f64; 14] = {
+    let mut t = [0.0; 14];
+    let mut i = 1;
+    while i < 14 {
+        t[i] = 1.0 / i as f64;
+        i += 1;
+    }
+    t
+};
+
+/// $v_{i} = 1/(i(i+1))$ (index 0 unused), the start of the $v$, $w$ recurrences of
+/// block 1 after a change of step size, as `STEP` divides them out.
+const V1: [f64; 14] = {
+    let mut t = [0.0; 14];
+    let mut i = 1;
+    while i < 14 {
+        t[i] = 1.0 / (i * (i + 1)) as f64;
+        i += 1;
+    }
+    t
+};
+
+/// Components the predictor sweeps together (two SSE2 registers).
+const LANES: usize = 4;
+
+/// The predictor's sweep for the components `l0..l0 + W`, column by column from `k`
+/// down to 1, with the sum and the carried difference in registers: $\phi_i \leftarrow
+/// \beta_i\phi_i$ for $i > n_s$ ($\phi^\ast$), $p \mathrel{+}= g_i\phi_i$, then
+/// $\phi_i \mathrel{+}= \phi_{i+1}$ ($\phi_{k+1} = 0$). Each entry sees the operations
+/// of `STEP`'s loops in their order.
+#[inline(always)]
+fn predict_lanes<const W: usize>(
+    phi: &mut [f64],
+    n: usize,
+    l0: usize,
+    c: &Coeffs,
+    k: usize,
+    p: &mut [f64],
+) {
+    let mut s = [0.0; W];
+    let mut next = [0.0; W];
+    for i in (1..=k).rev() {
+        let at = (i - 1) * n + l0;
+        let col = <&mut [f64; W]>::try_from(&mut phi[at..at + W]).expect("W entries");
+        if i > c.ns {
+            let b = c.beta[i];
+            for x in col.iter_mut() {
+                *x *= b;
+            }
+        }
+        let g = c.g[i];
+        for ((s, x), next) in s.iter_mut().zip(col.iter_mut()).zip(next.iter_mut()) {
+            *s += g * *x;
+            *x += *next;
+            *next = *x;
+        }
+    }
+    p[l0..l0 + W].copy_from_slice(&s);
 }
 
 impl Adams {
@@ -78,27 +139,31 @@ impl Adams {
         self.snapshot();
         let c = &mut self.c;
         c.beta[ns] = 1.0;
-        c.alpha[ns] = 1.0 / ns as f64;
+        c.alpha[ns] = INV[ns];
         let mut temp1 = h * ns as f64;
         c.sig[nsp1] = 1.0;
+        // The recurrences of beta and sigma carry their last value in a register
+        // (the same operations as STEP's, without a store and reload per term).
+        let (mut beta, mut sig) = (1.0, 1.0);
         for i in nsp1..=k {
             let im1 = i - 1;
             let temp2 = c.psi[im1];
             c.psi[im1] = temp1;
-            c.beta[i] = c.beta[im1] * c.psi[im1] / temp2;
+            beta = beta * temp1 / temp2;
+            c.beta[i] = beta;
             temp1 = temp2 + h;
-            c.alpha[i] = h / temp1;
-            c.sig[i + 1] = i as f64 * c.alpha[i] * c.sig[i];
+            let alpha = h / temp1;
+            c.alpha[i] = alpha;
+            sig *= i as f64 * alpha;
+            c.sig[i + 1] = sig;
         }
         c.psi[k] = temp1;
         if ns <= 1 {
-            for iq in 1..=k {
-                c.v[iq] = 1.0 / (iq * (iq + 1)) as f64;
-                c.w[iq] = c.v[iq];
-            }
+            c.v[1..=k].copy_from_slice(&V1[1..=k]);
+            c.w[1..=k].copy_from_slice(&V1[1..=k]);
         } else {
             if k > self.kold {
-                c.v[k] = 1.0 / (k * kp1) as f64;
+                c.v[k] = V1[k];
                 for j in 1..=ns.saturating_sub(2) {
                     let i = k - j;
                     c.v[i] -= c.alpha[j + 1] * c.v[i + 1];
@@ -126,25 +191,20 @@ impl Adams {
         let (n, k, h) = (self.y.len(), self.k, self.h);
         let c = &self.c;
         let phi = &mut self.phi[..(k + 2) * n];
-        for i in (c.ns + 1)..=k {
-            let b = c.beta[i];
-            phi[(i - 1) * n..i * n].iter_mut().for_each(|x| *x *= b);
-        }
         // phi_{k+2} = phi_{k+1}, phi_{k+1} = 0.
         let (lo, hi) = phi.split_at_mut((k + 1) * n);
         for (d, s) in hi.iter_mut().zip(&mut lo[k * n..]) {
             *d = *s;
             *s = 0.0;
         }
-        let p = &mut self.p[..];
-        p.fill(0.0);
-        for i in (1..=k).rev() {
-            let gi = c.g[i];
-            let (a, b) = phi[(i - 1) * n..(i + 1) * n].split_at_mut(n);
-            for ((p, x), next) in p.iter_mut().zip(a.iter_mut()).zip(&*b) {
-                *p += gi * *x;
-                *x += *next;
-            }
+        let p = &mut self.p[..n];
+        let mut l0 = 0;
+        while l0 + LANES <= n {
+            predict_lanes::<LANES>(phi, n, l0, c, k, p);
+            l0 += LANES;
+        }
+        for l0 in l0..n {
+            predict_lanes::<1>(phi, n, l0, c, k, p);
         }
         if self.nornd {
             for (p, y) in p.iter_mut().zip(&self.y) {
