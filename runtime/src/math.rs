@@ -346,7 +346,7 @@ mod tests {
     fn within_one_ulp_of_glibc() {
         let mut rng = Rng(0x5EED_0008);
         let ranges = [std::f64::consts::FRAC_PI_4, 10.0, 1e3, 1e5, REDUCTION_BOUND];
-        let mut check = |what: &str, (max, differ, ours, glibc): (u64, usize, f64, f64)| {
+        let check = |what: &str, (max, differ, ours, glibc): (u64, usize, f64, f64)| {
             eprintln!(
                 "{what}: {max} ulp from glibc at most, {differ} of 2e6 differ; \
                  error {ours:.3} ulp (glibc {glibc:.3})"
