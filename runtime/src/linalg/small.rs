@@ -389,6 +389,68 @@ mod tests {
         }
     }
 
+    /// The Cholesky solves agree with the
+    /// independent partial-pivoting LU on symmetric positive definite matrices of the
+    /// sizes of a mechanism's Gram matrices, `n` = 1 to 12, some with scales spread
+    /// over twelve orders of magnitude (which equilibration removes): the two solutions
+    /// to a few units of round-off times the condition of the equilibrated matrix.
+    #[test]
+    fn cholesky_solves_agree_with_lu() {
+        for n in 1..=12_usize {
+            for spread in [0.0, 12.0] {
+                // A = D (BᵀB + I) D with B from a sine, D = 10^(spread·i/n).
+                #[allow(clippy::cast_precision_loss)]
+                let d: Vec<f64> = (0..n)
+                    .map(|i| 10f64.powf(spread * i as f64 / n as f64))
+                    .collect();
+                #[allow(clippy::cast_precision_loss)]
+                let bm: Vec<f64> = (0..n * n).map(|k| (1.3 * k as f64 + 0.4).sin()).collect();
+                let a: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        let (i, j) = (k / n, k % n);
+                        let s: f64 = (0..n).map(|r| bm[r * n + i] * bm[r * n + j]).sum();
+                        d[i] * d[j] * (s + if i == j { 1.0 } else { 0.0 })
+                    })
+                    .collect();
+                let mut ch = SmallCholesky::new(n);
+                ch.matrix_mut().copy_from_slice(&a);
+                assert!(ch.factor().ratio() > 0.0);
+                let mut lu = SmallLu::new(n);
+                lu.matrix_mut().copy_from_slice(&a);
+                assert!(lu.factor().ratio() > 0.0);
+                // Three right-hand sides: a cosine, a unit vector, all ones.
+                #[allow(clippy::cast_precision_loss)]
+                let cols: Vec<Vec<f64>> = vec![
+                    (0..n).map(|i| (i as f64).cos()).collect(),
+                    (0..n).map(|i| if i == n / 2 { 1.0 } else { 0.0 }).collect(),
+                    vec![1.0; n],
+                ];
+                let mut rows: Vec<f64> = (0..n)
+                    .flat_map(|i| cols.iter().map(move |c| c[i]))
+                    .collect();
+                ch.solve_rows(&mut rows, 3);
+                for (c, b) in cols.iter().enumerate() {
+                    let (mut x, mut y) = (b.clone(), b.clone());
+                    ch.solve(&mut x);
+                    lu.solve(&mut y);
+                    for i in 0..n {
+                        // Relative to the solution's size in the equilibrated units.
+                        let size = (0..n).map(|j| (y[j] * d[j]).abs()).fold(0.0, f64::max);
+                        let err = ((x[i] - y[i]) * d[i]).abs();
+                        #[allow(clippy::cast_precision_loss)]
+                        let tol = 1e3 * f64::EPSILON * size * (n * n) as f64;
+                        assert!(
+                            err <= tol,
+                            "solve n = {n} spread {spread}: {err:e} > {tol:e}"
+                        );
+                        let err = ((rows[3 * i + c] - x[i]) * d[i]).abs();
+                        assert!(err <= tol, "solve_rows n = {n} spread {spread}: {err:e}");
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn singular_and_indefinite_matrices_are_reported() {
         let mut lu = SmallLu::new(2);
