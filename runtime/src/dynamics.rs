@@ -33,8 +33,17 @@
 //! leaves $J_D\ddot q - \gamma_D = O(\delta)$, which no choice of $\ddot q$ can remove
 //! without violating an independent row.
 //!
-//! Invariant: the dense and sparse paths do not allocate after the first call; the
-//! redundant path allocates.
+//! **The split is kept.** Redundancy is usually structural (Bricard's linkage, a
+//! parallelogram): the same rows stay dependent along the motion. The split $R$, $D$ of
+//! a redundant solve is kept with its buffers, and the next solve starts from it: one
+//! factorization of the reduced system, the consistency check of $D$ and the
+//! multipliers, without trying the full system first and without a complete pivoting
+//! of $J$. When the reduced matrix is no longer regular or the rows $D$ no longer agree
+//! with $\ddot q$ (the motion left the configurations where they are redundant), the
+//! split is dropped and the solve starts over from the full system.
+//!
+//! Invariant: no allocation after the first call, except when a new split of redundant
+//! rows is found (its buffers) and when building an error.
 
 use crate::linalg::dense::DenseLu;
 use crate::linalg::elimination::Elimination;
@@ -189,6 +198,89 @@ pub struct Dynamics {
     b: Vec<f64>,
     r: Vec<f64>,
     redundant: Vec<usize>,
+    /// The split of the last redundant solve, tried first while it serves.
+    split: Option<Split>,
+}
+
+/// Rows of $J$ split into an independent set $R$ and redundant rows $D$, with the
+/// buffers of a solve on it (see the module docs).
+#[derive(Debug)]
+struct Split {
+    rows_r: Vec<usize>,
+    rows_d: Vec<usize>,
+    /// For each row of $J$, its place in $R$ (`usize::MAX` for the rows of $D$).
+    slot: Vec<usize>,
+    /// The reduced augmented system ($n + r$ unknowns) and its solution.
+    reduced: Lu,
+    x: Vec<f64>,
+    /// $S = J_R J_R^\mathsf{T}$, then $A = I + X X^\mathsf{T}$ ($r \times r$).
+    gram: Lu,
+    /// $X = S^{-1} J_R J_D^\mathsf{T}$ by columns: column $k$ is `xt[k*r..(k+1)*r]`.
+    xt: Vec<f64>,
+    /// $\lambda_R$ mapped to the least-norm multipliers, length $r$.
+    y: Vec<f64>,
+}
+
+/// A dense factorization sized for its use: partial pivoting below the crossover,
+/// complete pivoting (faer) from it.
+#[derive(Debug)]
+enum Lu {
+    Small(SmallLu),
+    Dense(DenseLu),
+}
+
+impl Lu {
+    fn new(n: usize, crossover: usize) -> Self {
+        if n < crossover {
+            Self::Small(SmallLu::new(n))
+        } else {
+            Self::Dense(DenseLu::new(n, 1))
+        }
+    }
+
+    /// Zeroes the matrix and writes its entries with `fill(set)`.
+    fn fill(&mut self, fill: impl FnOnce(&mut dyn FnMut(usize, usize, f64))) {
+        match self {
+            Self::Small(lu) => {
+                let n = lu.dim();
+                let a = lu.matrix_mut();
+                a.fill(0.0);
+                fill(&mut |i, j, v| a[i * n + j] = v);
+            }
+            Self::Dense(lu) => {
+                let n = lu.dim();
+                let mut a = lu.matrix_mut();
+                for j in 0..n {
+                    for i in 0..n {
+                        a[(i, j)] = 0.0;
+                    }
+                }
+                fill(&mut |i, j, v| a[(i, j)] = v);
+            }
+        }
+    }
+
+    fn factor(&mut self) -> f64 {
+        match self {
+            Self::Small(lu) => lu.factor().ratio(),
+            Self::Dense(lu) => lu.factor().ratio(),
+        }
+    }
+
+    fn solve(&mut self, b: &mut [f64]) {
+        match self {
+            Self::Small(lu) => lu.solve(b),
+            Self::Dense(lu) => lu.solve_vec(b),
+        }
+    }
+}
+
+/// Why a split did not give a solution.
+enum SplitFailure {
+    /// The reduced augmented matrix is singular (pivot ratio).
+    Singular(f64),
+    /// The rows $D$ disagree with $\ddot q$ (residual).
+    Inconsistent(f64),
 }
 
 impl Dynamics {
@@ -220,6 +312,7 @@ impl Dynamics {
             b: vec![0.0; dim],
             r: vec![0.0; dim],
             redundant: Vec::with_capacity(info.nh() + info.nnh()),
+            split: None,
         })
     }
 
@@ -311,6 +404,31 @@ impl Dynamics {
         }
         self.redundant.clear();
 
+        if let Some(split) = self.split.as_mut() {
+            scatter_jacobian(info, ws);
+            let tol = self.params.redundant_tolerance;
+            match split.solve(
+                info,
+                ws,
+                &self.b,
+                tol,
+                self.params.rank_tolerance,
+                &mut self.x,
+            ) {
+                Ok(ratio) => {
+                    self.redundant.extend_from_slice(&split.rows_d);
+                    let stats = AccelerationStats {
+                        path: SolverPath::Redundant,
+                        rank: split.rows_r.len(),
+                        pivot_ratio: ratio,
+                    };
+                    return self.finish(t, qdd, lambda, stats);
+                }
+                // Not redundant there any more: from the full system.
+                Err(_) => self.split = None,
+            }
+        }
+
         if self.generated {
             self.x.copy_from_slice(&self.b);
             match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, &mut self.x) {
@@ -378,6 +496,18 @@ impl Dynamics {
             Some(s) => s,
             None => self.solve_redundant(ws, t)?,
         };
+        self.finish(t, qdd, lambda, stats)
+    }
+
+    /// Checks the solution in `x` and hands it out.
+    fn finish(
+        &self,
+        t: f64,
+        qdd: &mut [f64],
+        lambda: &mut [f64],
+        stats: AccelerationStats,
+    ) -> Result<AccelerationStats, DynamicsError> {
+        let n = self.info.nq();
         check_finite(Quantity::Accelerations, t, &self.x[..n])?;
         check_finite(Quantity::Multipliers, t, &self.x[n..])?;
         qdd.copy_from_slice(&self.x[..n]);
@@ -385,24 +515,18 @@ impl Dynamics {
         Ok(stats)
     }
 
-    /// The rank-deficient path (allocates).
-    #[allow(non_snake_case)]
+    /// The rank-deficient path: finds the split of $J$ by complete pivoting (allocates
+    /// its buffers) and solves on it; the split is kept for the next solves.
     fn solve_redundant(
         &mut self,
         ws: &mut Workspace,
         t: f64,
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
-        let (n, mh) = (info.nq(), info.nh());
-        let m = mh + info.nnh();
-        {
-            let (h, nh) = ws.jacobian.split_at_mut(mh * n);
-            scatter_row_major(info.holonomic_pattern, &ws.cq_values, n, h);
-            scatter_row_major(info.nonholonomic_pattern, &ws.g_values, n, nh);
-        }
-        let J = &ws.jacobian;
+        let (n, m) = (info.nq(), info.nh() + info.nnh());
+        scatter_jacobian(info, ws);
         let mut elim = Elimination::new(m, n);
-        elim.load(J);
+        elim.load(&ws.jacobian);
         // The constraint block of the augmented matrix has pivots of the order of those
         // of J M⁻¹ Jᵀ, the squares of J's: rows of J whose pivot ratio is below the
         // square root of the tolerance are what made the augmented matrix fail it (near
@@ -419,110 +543,168 @@ impl Dynamics {
                 coordinates,
             });
         }
-        let rows_r: Vec<usize> = elim.rows[..rank].to_vec();
-        let rows_d: Vec<usize> = elim.rows[rank..].to_vec();
-        self.redundant.extend_from_slice(&rows_d);
-        let row = |i: usize| &J[i * n..(i + 1) * n];
-        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let mut split = Split::new(
+            n,
+            m,
+            elim.rows[..rank].to_vec(),
+            elim.rows[rank..].to_vec(),
+            self.params.crossover,
+        );
+        self.redundant.extend_from_slice(&split.rows_d);
+        let (tol, rank_tol) = (self.params.redundant_tolerance, self.params.rank_tolerance);
+        match split.solve(info, ws, &self.b, tol, rank_tol, &mut self.x) {
+            Ok(ratio) => {
+                self.split = Some(split);
+                Ok(AccelerationStats {
+                    path: SolverPath::Redundant,
+                    rank,
+                    pivot_ratio: ratio,
+                })
+            }
+            Err(SplitFailure::Singular(ratio)) => {
+                let mut lu = DenseLu::new(n + rank, 1);
+                fill_dense(&mut lu, info, ws, Some(&split.slot));
+                Err(DynamicsError::Singular {
+                    t,
+                    rank,
+                    ratio,
+                    coordinates: free_coordinates(&mut lu, info, rank_tol),
+                })
+            }
+            Err(SplitFailure::Inconsistent(residual)) => {
+                Err(DynamicsError::InconsistentRedundant {
+                    t,
+                    constraints: self.redundant_constraints().collect(),
+                    residual,
+                })
+            }
+        }
+    }
+}
 
-        // Reduced augmented system with the independent rows.
-        let mut lu = DenseLu::new(n + rank, 1);
-        fill_dense(&mut lu, info, ws, Some(&rows_r));
-        let coordinates = free_coordinates(&mut lu, info, self.params.rank_tolerance);
-        let ratio = lu.factor().ratio();
-        if ratio.is_nan() || ratio <= self.params.rank_tolerance {
-            return Err(DynamicsError::Singular {
-                t,
-                rank,
-                ratio,
-                coordinates,
-            });
-        }
-        let mut x = vec![0.0; n + rank];
-        x[..n].copy_from_slice(&self.b[..n]);
+impl Split {
+    /// Buffers for the split `rows_r`, `rows_d` of the `m` rows of $J$ ($n$ columns).
+    fn new(n: usize, m: usize, rows_r: Vec<usize>, rows_d: Vec<usize>, crossover: usize) -> Self {
+        let r = rows_r.len();
+        let mut slot = vec![usize::MAX; m];
         for (k, &i) in rows_r.iter().enumerate() {
-            x[n + k] = self.b[n + i];
+            slot[i] = k;
         }
-        lu.solve_vec(&mut x);
+        Self {
+            reduced: Lu::new(n + r, crossover),
+            x: vec![0.0; n + r],
+            gram: Lu::new(r, crossover),
+            xt: vec![0.0; r * rows_d.len()],
+            y: vec![0.0; r],
+            rows_r,
+            rows_d,
+            slot,
+        }
+    }
+
+    /// Solves the augmented system on the rows $R$, checks the rows $D$ and writes
+    /// $[\ddot q; \lambda]$ (least-norm multipliers, module docs) into `out`; `b` is
+    /// the full right-hand side $[Q; \gamma]$, $J$ is in `ws.jacobian` (dense). Returns
+    /// the pivot ratio of the reduced matrix.
+    #[allow(non_snake_case)]
+    fn solve(
+        &mut self,
+        info: &Info,
+        ws: &Workspace,
+        b: &[f64],
+        redundant_tolerance: f64,
+        rank_tolerance: f64,
+        out: &mut [f64],
+    ) -> Result<f64, SplitFailure> {
+        let n = info.nq();
+        let r = self.rows_r.len();
+        let slot = &self.slot;
+        self.reduced
+            .fill(|set| augmented_entries(info, ws, Some(slot), set));
+        let ratio = self.reduced.factor();
+        if ratio.is_nan() || ratio <= rank_tolerance {
+            return Err(SplitFailure::Singular(ratio));
+        }
+        let x = &mut self.x;
+        x[..n].copy_from_slice(&b[..n]);
+        for (xk, &i) in x[n..].iter_mut().zip(&self.rows_r) {
+            *xk = b[n + i];
+        }
+        self.reduced.solve(x);
         let qdd = &x[..n];
 
         // The redundant rows must be satisfied by q̈ too, relative to the accelerations
         // at play: those of the solution and those the forces alone would give,
         // max_j |Q_j| / M_jj (at a static equilibrium q̈ = 0 while the forces are not).
+        let J = &ws.jacobian;
+        let row = |i: usize| &J[i * n..(i + 1) * n];
         let forced = info
             .mass_pattern
             .iter()
             .zip(&ws.mass_values)
             .filter(|(&(r, c), &m)| r == c && m != 0.0)
-            .fold(0.0_f64, |a, (&(r, _), &m)| {
-                a.max((self.b[r as usize] / m).abs())
-            });
-        let mut residual = 0.0_f64;
-        let mut scale = 0.0_f64;
-        for &d in &rows_d {
+            .fold(0.0_f64, |a, (&(r, _), &m)| a.max((b[r as usize] / m).abs()));
+        let (mut residual, mut scale) = (0.0_f64, 0.0_f64);
+        for &d in &self.rows_d {
             let jd = row(d);
-            residual = residual.max((dot(jd, qdd) - self.b[n + d]).abs());
-            scale = scale.max(inf_norm(jd) * (inf_norm(qdd) + forced) + self.b[n + d].abs());
+            residual = residual.max((dot(jd, qdd) - b[n + d]).abs());
+            scale = scale.max(inf_norm(jd) * (inf_norm(qdd) + forced) + b[n + d].abs());
         }
-        if residual.is_nan()
-            || residual > self.params.redundant_tolerance * scale.max(f64::MIN_POSITIVE)
-        {
-            return Err(DynamicsError::InconsistentRedundant {
-                t,
-                constraints: self.redundant_constraints().collect(),
-                residual,
-            });
+        if residual.is_nan() || residual > redundant_tolerance * scale.max(f64::MIN_POSITIVE) {
+            return Err(SplitFailure::Inconsistent(residual));
         }
 
-        // Minimum-norm multipliers: T_D = J_D J_Rᵀ (J_R J_Rᵀ)⁻¹, λ = T (TᵀT)⁻¹ λ_R.
-        let (r, d) = (rank, rows_d.len());
-        let mut s_lu = DenseLu::new(r, d.max(r));
-        {
-            let mut s = s_lu.matrix_mut();
+        // Least-norm multipliers: T_D = J_D J_Rᵀ (J_R J_Rᵀ)⁻¹, λ = T (TᵀT)⁻¹ λ_R. With
+        // X = S⁻¹ J_R J_Dᵀ (S = J_R J_Rᵀ symmetric), T_D = Xᵀ and TᵀT = I + X Xᵀ.
+        let rows_r = &self.rows_r;
+        self.gram.fill(|set| {
+            for (a, &ra) in rows_r.iter().enumerate() {
+                for (c, &rc) in rows_r.iter().enumerate() {
+                    set(a, c, dot(row(ra), row(rc)));
+                }
+            }
+        });
+        self.gram.factor();
+        for (column, &d) in self.xt.chunks_exact_mut(r.max(1)).zip(&self.rows_d) {
+            for (v, &ra) in column.iter_mut().zip(rows_r) {
+                *v = dot(row(ra), row(d));
+            }
+            self.gram.solve(column);
+        }
+        let xt = &self.xt;
+        self.gram.fill(|set| {
             for a in 0..r {
-                for b in 0..r {
-                    s[(a, b)] = dot(row(rows_r[a]), row(rows_r[b]));
+                for c in 0..r {
+                    let xx: f64 = xt.chunks_exact(r).map(|col| col[a] * col[c]).sum();
+                    set(a, c, f64::from(u8::from(a == c)) + xx);
                 }
             }
-        }
-        s_lu.factor();
-        // X = S⁻¹ J_R J_Dᵀ (r × d); T_D = Xᵀ since S is symmetric.
-        let mut X = faer::Mat::<f64>::zeros(r, d);
-        for a in 0..r {
-            for b in 0..d {
-                X[(a, b)] = dot(row(rows_r[a]), row(rows_d[b]));
-            }
-        }
-        s_lu.solve_in_place(X.as_mut());
-        let mut a_lu = DenseLu::new(r, 1);
-        {
-            let mut a = a_lu.matrix_mut();
-            for i in 0..r {
-                for j in 0..r {
-                    let mut v = if i == j { 1.0 } else { 0.0 };
-                    for k in 0..d {
-                        v += X[(i, k)] * X[(j, k)];
-                    }
-                    a[(i, j)] = v;
-                }
-            }
-        }
-        a_lu.factor();
-        let mut y = x[n..].to_vec();
-        a_lu.solve_vec(&mut y);
-        self.x[..n].copy_from_slice(qdd);
+        });
+        self.gram.factor();
+        self.y.copy_from_slice(&x[n..]);
+        self.gram.solve(&mut self.y);
+        out[..n].copy_from_slice(qdd);
         for (k, &i) in rows_r.iter().enumerate() {
-            self.x[n + i] = y[k];
+            out[n + i] = self.y[k];
         }
-        for (k, &i) in rows_d.iter().enumerate() {
-            self.x[n + i] = (0..r).map(|a| X[(a, k)] * y[a]).sum();
+        for (k, &d) in self.rows_d.iter().enumerate() {
+            out[n + d] = dot(&xt[k * r..(k + 1) * r], &self.y);
         }
-        Ok(AccelerationStats {
-            path: SolverPath::Redundant,
-            rank,
-            pivot_ratio: ratio,
-        })
+        Ok(ratio)
     }
+}
+
+/// $\sum_i a_i b_i$.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Writes $J = [C_q; G]$ dense, row-major, into `ws.jacobian`.
+fn scatter_jacobian(info: &Info, ws: &mut Workspace) {
+    let (n, mh) = (info.nq(), info.nh());
+    let (h, nh) = ws.jacobian.split_at_mut(mh * n);
+    scatter_row_major(info.holonomic_pattern, &ws.cq_values, n, h);
+    scatter_row_major(info.nonholonomic_pattern, &ws.g_values, n, nh);
 }
 
 /// The coordinates whose accelerations the augmented matrix in `lu` (filled, not yet
@@ -560,11 +742,12 @@ fn free_list(coordinates: &[&str]) -> String {
 
 /// Calls `set(i, j, v)` for the non-zero entries of
 /// $\begin{bmatrix}M & J_R^\mathsf{T}\\ J_R & 0\end{bmatrix}$, with $J_R$ the rows
-/// `rows` of $J$ (all rows when `None`).
+/// of $J$ that `slot` places (row `i` at `slot[i]`, dropped when `usize::MAX`; all rows
+/// in order when `None`).
 fn augmented_entries(
     info: &Info,
     ws: &Workspace,
-    rows: Option<&[usize]>,
+    slot: Option<&[usize]>,
     mut set: impl FnMut(usize, usize, f64),
 ) {
     let n = info.nq();
@@ -574,9 +757,9 @@ fn augmented_entries(
     }
     // Position of constraint row `i` in the reduced system, if kept.
     let slot = |i: usize| -> Option<usize> {
-        match rows {
+        match slot {
             None => Some(i),
-            Some(rows) => rows.iter().position(|&k| k == i),
+            Some(slot) => Some(slot[i]).filter(|&k| k != usize::MAX),
         }
     };
     let blocks = [
@@ -593,9 +776,9 @@ fn augmented_entries(
     }
 }
 
-/// Writes the augmented matrix with the rows `rows` of $J$ into `lu` (see
+/// Writes the augmented matrix with the rows of $J$ that `slot` places into `lu` (see
 /// [`augmented_entries`]).
-fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usize]>) {
+fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, slot: Option<&[usize]>) {
     let dim = lu.dim();
     let mut a = lu.matrix_mut();
     for j in 0..dim {
@@ -603,7 +786,7 @@ fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, rows: Option<&[usiz
             a[(i, j)] = 0.0;
         }
     }
-    augmented_entries(info, ws, rows, |i, j, v| a[(i, j)] = v);
+    augmented_entries(info, ws, slot, |i, j, v| a[(i, j)] = v);
 }
 
 /// Writes the augmented matrix into the row-major `lu`.

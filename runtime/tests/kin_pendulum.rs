@@ -215,6 +215,49 @@ fn a_full_consistent_state_is_accepted_as_given() {
     ));
 }
 
+/// A solver that found the duplicated row keeps that split for the next solves: at a
+/// second state it must give what a fresh solver gives there (the same equations on the
+/// same rows), and on a configuration where the kept rows no longer suffice it must start
+/// over from the full system instead of answering from the stale split.
+#[test]
+fn kept_split_of_redundant_rows_matches_a_fresh_solve() {
+    let dup = Pendulum::new(true);
+    let states = [
+        ([0.6, -0.8], [0.8 * 1.5, 0.6 * 1.5]),
+        ([0.8, -0.6], [0.6 * 0.5, 0.8 * 0.5]),
+        ([-0.28, -0.96], [0.0, 0.0]),
+    ];
+    let mut ws = Workspace::new(dup.info()).unwrap();
+    let mut kept = Dynamics::new(dup.info(), DynamicsParams::default()).unwrap();
+    for (q, qd) in states {
+        let (mut a, mut l) = ([0.0; 2], [0.0; 2]);
+        let stats = kept
+            .accelerations(&dup, &mut ws, 0.0, &q, &qd, &mut a, &mut l)
+            .unwrap();
+        let mut fresh = Dynamics::new(dup.info(), DynamicsParams::default()).unwrap();
+        let (mut a1, mut l1) = ([0.0; 2], [0.0; 2]);
+        fresh
+            .accelerations(&dup, &mut ws, 0.0, &q, &qd, &mut a1, &mut l1)
+            .unwrap();
+        assert_eq!(stats.path, SolverPath::Redundant);
+        for (x, y) in a.iter().chain(&l).zip(a1.iter().chain(&l1)) {
+            assert!(
+                (x - y).abs() < 1e-13 * (1.0 + y.abs()),
+                "{a:?} {l:?} vs {a1:?} {l1:?}"
+            );
+        }
+    }
+    // At the origin both rows vanish and the kept split's reduced matrix is singular:
+    // the solve starts over and reports rank 0 with free fall and no multipliers.
+    let (mut a, mut l) = ([0.0; 2], [0.0; 2]);
+    let stats = kept
+        .accelerations(&dup, &mut ws, 0.0, &[0.0, 0.0], &[0.0; 2], &mut a, &mut l)
+        .unwrap();
+    assert_eq!((stats.path, stats.rank), (SolverPath::Redundant, 0));
+    assert!(a[0].abs() < 1e-15 && (a[1] + common::G).abs() < 1e-14);
+    assert_eq!(l, [0.0, 0.0], "{l:?}");
+}
+
 #[test]
 fn duplicated_constraint_gives_minimum_norm_multipliers() {
     let single = Pendulum::new(false);

@@ -80,6 +80,18 @@ struct Coeffs {
     ns: usize,
 }
 
+impl Coeffs {
+    /// The coefficients after a reset: $g_1 = 1$, $g_2 = \tfrac12$, $\sigma_1 = 1$
+    /// (constants `STEP` sets on every call), everything else zero.
+    fn start() -> Self {
+        let mut c = Self::default();
+        c.g[1] = 1.0;
+        c.g[2] = 0.5;
+        c.sig[1] = 1.0;
+        c
+    }
+}
+
 /// Shampine–Gordon variable-order variable-step Adams PECE integrator.
 #[derive(Clone, Debug)]
 pub struct Adams {
@@ -107,11 +119,19 @@ pub struct Adams {
     kle4: u32,
     attempts: u64,
     c: Coeffs,
+    /// The coefficients at the start of the current step (see `step::snapshot`).
+    saved: Coeffs,
+    /// Whether `saved` has been taken in the current call of `sg_step`.
+    snapped: bool,
     y: Vec<f64>,
     y_new: Vec<f64>,
     p: Vec<f64>,
     yp: Vec<f64>,
     wt: Vec<f64>,
+    /// $1/wt_l$.
+    rwt: Vec<f64>,
+    /// $\sqrt{\sum_l (y_l/wt_l)^2}$ with the weights of the current step.
+    ynorm: f64,
     /// Columns 1..=16 of $\phi$, column-major.
     phi: Vec<f64>,
     stats: OdeStats,
@@ -143,12 +163,16 @@ impl Adams {
             nornd: true,
             kle4: 0,
             attempts: 0,
-            c: Coeffs::default(),
+            c: Coeffs::start(),
+            saved: Coeffs::start(),
+            snapped: false,
             y: v(),
             y_new: v(),
             p: v(),
             yp: v(),
             wt: v(),
+            rwt: v(),
+            ynorm: 0.0,
             phi: vec![0.0; 16 * dim],
             stats: OdeStats::default(),
         })
@@ -181,27 +205,45 @@ impl Adams {
         self.kle4 >= 50
     }
 
-    /// $\sqrt{\sum_l (y_l/wt_l)^2}$.
-    fn y_norm(&self) -> f64 {
-        let mut s = 0.0;
-        for (y, wt) in self.y.iter().zip(&self.wt) {
-            s += (y / wt).powi(2);
-        }
-        s.sqrt()
-    }
-
-    /// Sets $wt_l = (\text{rtol}|y_l| + \text{atol}_l)/\varepsilon_{\text{user}}$.
+    /// Sets $wt_l = (\text{rtol}|y_l| + \text{atol}_l)/\varepsilon_{\text{user}}$, their
+    /// inverses, and the weighted norm of $y$, $\sqrt{\sum_l (y_l/wt_l)^2}$ (the
+    /// element-wise loops vectorize; the sum runs in the order of the components).
     fn set_weights(&mut self) -> Result<(), OdeError> {
         let tol = &self.opts.tol;
-        for (l, (wt, y)) in self.wt.iter_mut().zip(&self.y).enumerate() {
-            *wt = (tol.rtol * y.abs() + tol.atol(l)) / self.eps_user;
-            if *wt <= 0.0 {
-                // A pure relative test on a zero component (DE's iflag = 6).
-                return Err(OdeError::InvalidTolerance {
-                    rtol: tol.rtol,
-                    atol: tol.atol(l),
-                });
+        let (rtol, eps) = (tol.rtol, self.eps_user);
+        let n = self.y.len();
+        let (wt, rwt, y) = (&mut self.wt[..n], &mut self.rwt[..n], &self.y[..n]);
+        match &tol.atol_components {
+            None => {
+                let atol = tol.atol;
+                for (wt, y) in wt.iter_mut().zip(y) {
+                    *wt = (rtol * y.abs() + atol) / eps;
+                }
             }
+            Some(a) => {
+                for ((wt, y), atol) in wt.iter_mut().zip(y).zip(&a[..n]) {
+                    *wt = (rtol * y.abs() + atol) / eps;
+                }
+            }
+        }
+        if let Some(l) = wt.iter().position(|wt| *wt <= 0.0) {
+            // A pure relative test on a zero component (DE's iflag = 6).
+            return Err(OdeError::InvalidTolerance {
+                rtol,
+                atol: tol.atol(l),
+            });
+        }
+        // `rwt` holds y/wt for the sum first, then 1/wt.
+        for ((r, wt), y) in rwt.iter_mut().zip(&*wt).zip(y) {
+            *r = y / wt;
+        }
+        let mut s = 0.0;
+        for r in rwt.iter() {
+            s += r.powi(2);
+        }
+        self.ynorm = s.sqrt();
+        for (r, wt) in rwt.iter_mut().zip(&*wt) {
+            *r = 1.0 / wt;
         }
         Ok(())
     }
@@ -264,11 +306,11 @@ impl Integrator for Adams {
         self.hold = 0.0;
         self.k = 1;
         self.kold = 0;
-        self.c = Coeffs::default();
+        self.c = Coeffs::start();
         self.phase1 = true;
         self.kle4 = 0;
         self.attempts = 0;
-        let round = 2.0 * UROUND * self.y_norm();
+        let round = 2.0 * UROUND * self.ynorm;
         self.nornd = 0.5 * self.eps > 100.0 * round;
         if !self.nornd {
             self.phi[14 * n..15 * n].fill(0.0);

@@ -16,7 +16,7 @@
 use super::super::common::{eval, is_recoverable, RECOVER_FACTOR, UROUND};
 use super::super::error::OdeError;
 use super::super::system::OdeSystem;
-use super::Adams;
+use super::{Adams, Coeffs};
 
 /// $\gamma^\ast_1..\gamma^\ast_{13}$ of `ode.f` (math-spec §9.1), 1-based.
 const GSTR: [f64; 14] = [
@@ -42,18 +42,80 @@ struct Estimates {
     knew: usize,
 }
 
+/// $1/i$ (index 0 unused), the values `STEP` divides out.
+const INV: [f64; 14] = {
+    let mut t = [0.0; 14];
+    let mut i = 1;
+    while i < 14 {
+        t[i] = 1.0 / i as f64;
+        i += 1;
+    }
+    t
+};
+
+/// $v_{i} = 1/(i(i+1))$ (index 0 unused), the start of the $v$, $w$ recurrences of
+/// block 1 after a change of step size, as `STEP` divides them out.
+const V1: [f64; 14] = {
+    let mut t = [0.0; 14];
+    let mut i = 1;
+    while i < 14 {
+        t[i] = 1.0 / (i * (i + 1)) as f64;
+        i += 1;
+    }
+    t
+};
+
+/// Components the predictor sweeps together (two SSE2 registers).
+const LANES: usize = 4;
+
+/// The predictor's sweep for the components `l0..l0 + W`, column by column from `k`
+/// down to 1, with the sum and the carried difference in registers: $\phi_i \leftarrow
+/// \beta_i\phi_i$ for $i > n_s$ ($\phi^\ast$), $p \mathrel{+}= g_i\phi_i$, then
+/// $\phi_i \mathrel{+}= \phi_{i+1}$ ($\phi_{k+1} = 0$). Each entry sees the operations
+/// of `STEP`'s loops in their order.
+#[inline(always)]
+fn predict_lanes<const W: usize>(
+    phi: &mut [f64],
+    n: usize,
+    l0: usize,
+    c: &Coeffs,
+    k: usize,
+    p: &mut [f64],
+) {
+    let mut s = [0.0; W];
+    let mut next = [0.0; W];
+    for i in (1..=k).rev() {
+        let at = (i - 1) * n + l0;
+        let col = <&mut [f64; W]>::try_from(&mut phi[at..at + W]).expect("W entries");
+        if i > c.ns {
+            let b = c.beta[i];
+            for x in col.iter_mut() {
+                *x *= b;
+            }
+        }
+        let g = c.g[i];
+        for ((s, x), next) in s.iter_mut().zip(col.iter_mut()).zip(next.iter_mut()) {
+            *s += g * *x;
+            *x += *next;
+            *next = *x;
+        }
+    }
+    p[l0..l0 + W].copy_from_slice(&s);
+}
+
 impl Adams {
     #[inline]
     fn col(&self, i: usize) -> usize {
         (i - 1) * self.y.len()
     }
 
-    /// `out = phi_i`-weighted norm helper: $\sqrt{\sum_l (x_l/wt_l)^2}$ of column `i`.
+    /// $\sqrt{\sum_l (\phi_{i,l}/wt_l)^2}$, the weighted norm of column `i`.
     fn col_norm(&self, i: usize) -> f64 {
+        let n = self.y.len();
         let c = self.col(i);
         let mut s = 0.0;
-        for (l, wt) in self.wt.iter().enumerate() {
-            s += (self.phi[c + l] / wt).powi(2);
+        for (x, wt) in self.phi[c..c + n].iter().zip(&self.wt) {
+            s += (x / wt).powi(2);
         }
         s.sqrt()
     }
@@ -63,40 +125,45 @@ impl Adams {
     fn block1(&mut self) {
         let (k, h) = (self.k, self.h);
         let (kp1, kp2) = (k + 1, k + 2);
-        let c = &mut self.c;
         if h != self.hold {
-            c.ns = 0;
+            self.c.ns = 0;
         }
-        if c.ns <= self.kold {
-            c.ns += 1;
+        if self.c.ns <= self.kold {
+            self.c.ns += 1;
         }
-        let ns = c.ns;
+        let ns = self.c.ns;
         let nsp1 = ns + 1;
         if k < ns {
             return;
         }
+        self.snapshot();
+        let c = &mut self.c;
         c.beta[ns] = 1.0;
-        c.alpha[ns] = 1.0 / ns as f64;
+        c.alpha[ns] = INV[ns];
         let mut temp1 = h * ns as f64;
         c.sig[nsp1] = 1.0;
+        // The recurrences of beta and sigma carry their last value in a register
+        // (the same operations as STEP's, without a store and reload per term).
+        let (mut beta, mut sig) = (1.0, 1.0);
         for i in nsp1..=k {
             let im1 = i - 1;
             let temp2 = c.psi[im1];
             c.psi[im1] = temp1;
-            c.beta[i] = c.beta[im1] * c.psi[im1] / temp2;
+            beta = beta * temp1 / temp2;
+            c.beta[i] = beta;
             temp1 = temp2 + h;
-            c.alpha[i] = h / temp1;
-            c.sig[i + 1] = i as f64 * c.alpha[i] * c.sig[i];
+            let alpha = h / temp1;
+            c.alpha[i] = alpha;
+            sig *= i as f64 * alpha;
+            c.sig[i + 1] = sig;
         }
         c.psi[k] = temp1;
         if ns <= 1 {
-            for iq in 1..=k {
-                c.v[iq] = 1.0 / (iq * (iq + 1)) as f64;
-                c.w[iq] = c.v[iq];
-            }
+            c.v[1..=k].copy_from_slice(&V1[1..=k]);
+            c.w[1..=k].copy_from_slice(&V1[1..=k]);
         } else {
             if k > self.kold {
-                c.v[k] = 1.0 / (k * kp1) as f64;
+                c.v[k] = V1[k];
                 for j in 1..=ns.saturating_sub(2) {
                     let i = k - j;
                     c.v[i] -= c.alpha[j + 1] * c.v[i + 1];
@@ -119,38 +186,36 @@ impl Adams {
     }
 
     /// Block 2 (first half): $\phi \to \phi^\ast$, predictor $p$, differences for the
-    /// corrector, and $x \leftarrow x + h$.
+    /// corrector, and $x \leftarrow x + h$. Only columns `1..=k+2` are touched.
     fn predict(&mut self) {
         let (n, k, h) = (self.y.len(), self.k, self.h);
-        let (kp1, kp2) = (k + 1, k + 2);
-        for i in (self.c.ns + 1)..=k {
-            let (ci, b) = (self.col(i), self.c.beta[i]);
-            self.phi[ci..ci + n].iter_mut().for_each(|x| *x *= b);
+        let c = &self.c;
+        let phi = &mut self.phi[..(k + 2) * n];
+        // phi_{k+2} = phi_{k+1}, phi_{k+1} = 0.
+        let (lo, hi) = phi.split_at_mut((k + 1) * n);
+        for (d, s) in hi.iter_mut().zip(&mut lo[k * n..]) {
+            *d = *s;
+            *s = 0.0;
         }
-        let (c1, c2) = (self.col(kp1), self.col(kp2));
-        for l in 0..n {
-            self.phi[c2 + l] = self.phi[c1 + l];
-            self.phi[c1 + l] = 0.0;
-            self.p[l] = 0.0;
+        let p = &mut self.p[..n];
+        let mut l0 = 0;
+        while l0 + LANES <= n {
+            predict_lanes::<LANES>(phi, n, l0, c, k, p);
+            l0 += LANES;
         }
-        for j in 1..=k {
-            let i = kp1 - j;
-            let (ci, cn, gi) = (self.col(i), self.col(i + 1), self.c.g[i]);
-            for l in 0..n {
-                self.p[l] += gi * self.phi[ci + l];
-                self.phi[ci + l] += self.phi[cn + l];
-            }
+        for l0 in l0..n {
+            predict_lanes::<1>(phi, n, l0, c, k, p);
         }
         if self.nornd {
-            for l in 0..n {
-                self.p[l] = self.y[l] + h * self.p[l];
+            for (p, y) in p.iter_mut().zip(&self.y) {
+                *p = y + h * *p;
             }
         } else {
-            let (c15, c16) = (self.col(15), self.col(16));
-            for l in 0..n {
-                let tau = h * self.p[l] - self.phi[c15 + l];
-                self.p[l] = self.y[l] + tau;
-                self.phi[c16 + l] = (self.p[l] - self.y[l]) - tau;
+            let (c15, c16) = self.phi[14 * n..16 * n].split_at_mut(n);
+            for (((p, y), c15), c16) in p.iter_mut().zip(&self.y).zip(&*c15).zip(c16) {
+                let tau = h * *p - c15;
+                *p = y + tau;
+                *c16 = (*p - y) - tau;
             }
         }
         self.xold = self.x;
@@ -160,21 +225,35 @@ impl Adams {
     /// Block 2 (second half): errors at orders $k$, $k-1$, $k-2$ and whether to lower
     /// the order; `yp` holds $f(x, p)$.
     fn estimate(&self) -> Estimates {
-        let k = self.k;
+        let (n, k) = (self.y.len(), self.k);
         let km2 = k as isize - 2;
-        let (c1, ck) = (self.col(1), self.col(k));
-        let ckm1 = if k >= 2 { self.col(k - 1) } else { 0 };
+        let phi = &self.phi;
+        let (yp, rwt, phi1) = (&self.yp[..n], &self.rwt[..n], &phi[..n]);
         let (mut erkm2, mut erkm1, mut erk) = (0.0, 0.0, 0.0);
-        for l in 0..self.y.len() {
-            let temp3 = 1.0 / self.wt[l];
-            let temp4 = self.yp[l] - self.phi[c1 + l];
-            if km2 > 0 {
-                erkm2 += ((self.phi[ckm1 + l] + temp4) * temp3).powi(2);
+        // One loop per case, each sum in the order of the components.
+        if km2 > 0 {
+            let (ckm1, ck) = (self.col(k - 1), self.col(k));
+            let (phikm1, phik) = (&phi[ckm1..ckm1 + n], &phi[ck..ck + n]);
+            for ((((yp, phi1), temp3), phikm1), phik) in
+                yp.iter().zip(phi1).zip(rwt).zip(phikm1).zip(phik)
+            {
+                let temp4 = yp - phi1;
+                erkm2 += ((phikm1 + temp4) * temp3).powi(2);
+                erkm1 += ((phik + temp4) * temp3).powi(2);
+                erk += (temp4 * temp3).powi(2);
             }
-            if km2 >= 0 {
-                erkm1 += ((self.phi[ck + l] + temp4) * temp3).powi(2);
+        } else if km2 == 0 {
+            let ck = self.col(k);
+            let phik = &phi[ck..ck + n];
+            for (((yp, phi1), temp3), phik) in yp.iter().zip(phi1).zip(rwt).zip(phik) {
+                let temp4 = yp - phi1;
+                erkm1 += ((phik + temp4) * temp3).powi(2);
+                erk += (temp4 * temp3).powi(2);
             }
-            erk += (temp4 * temp3).powi(2);
+        } else {
+            for ((yp, phi1), temp3) in yp.iter().zip(phi1).zip(rwt) {
+                erk += ((yp - phi1) * temp3).powi(2);
+            }
         }
         let absh = self.h.abs();
         let c = &self.c;
@@ -202,12 +281,14 @@ impl Adams {
     /// Block 3 (first half): undo $\phi^\ast$ and the predictor's updates of `phi`,
     /// `psi` and $x$.
     fn restore(&mut self) {
+        self.snapshot();
         let (n, k, h) = (self.y.len(), self.k, self.h);
         self.x = self.xold;
         for i in 1..=k {
-            let (ci, cn, r) = (self.col(i), self.col(i + 1), 1.0 / self.c.beta[i]);
-            for l in 0..n {
-                self.phi[ci + l] = r * (self.phi[ci + l] - self.phi[cn + l]);
+            let r = 1.0 / self.c.beta[i];
+            let (a, b) = self.phi[(i - 1) * n..(i + 1) * n].split_at_mut(n);
+            for (x, next) in a.iter_mut().zip(&*b) {
+                *x = r * (*x - next);
             }
         }
         for i in 2..=k {
@@ -215,11 +296,23 @@ impl Adams {
         }
     }
 
+    /// Saves the coefficients before their first change in this call of
+    /// [`sg_step`](Self::sg_step) (other than $n_s$, saved at its start), for
+    /// [`abort`](Self::abort). Steps that keep $h$ and the order change nothing else
+    /// and copy nothing.
+    fn snapshot(&mut self) {
+        if !self.snapped {
+            self.saved = self.c;
+            self.snapped = true;
+        }
+    }
+
     /// Restores the state of the last accepted step after an error in the middle of
-    /// an attempt (`saved` are the coefficients at the start of `step`).
-    fn abort(&mut self, saved: super::Coeffs, error: OdeError) -> OdeError {
+    /// an attempt (`ns` is $n_s$ at the start of `sg_step`).
+    fn abort(&mut self, ns: usize, error: OdeError) -> OdeError {
         self.restore();
-        self.c = saved;
+        self.c = self.saved;
+        self.c.ns = ns;
         error
     }
 
@@ -253,7 +346,7 @@ impl Adams {
             });
         }
         let mut p5eps = 0.5 * self.eps;
-        let round = 2.0 * UROUND * self.y_norm();
+        let round = 2.0 * UROUND * self.ynorm;
         if p5eps < round {
             // Block 0: a tolerance below round-off is raised, as ode.f does.
             let eps = 2.0 * round * (1.0 + fouru);
@@ -261,10 +354,10 @@ impl Adams {
             self.eps = eps;
             p5eps = 0.5 * eps;
         }
-        self.c.g[1] = 1.0;
-        self.c.g[2] = 0.5;
-        self.c.sig[1] = 1.0;
-        let saved = self.c;
+        // The coefficients at the start, for `abort`: n_s now, the rest before its
+        // first change (`snapshot`).
+        let saved = self.c.ns;
+        self.snapped = false;
         let mut ifail = 0;
         let mut failure = None;
         let est = loop {
@@ -315,17 +408,24 @@ impl Adams {
         let (k, h) = (self.k, self.h);
         let (kp1, kp2) = (k + 1, k + 2);
         let temp1 = h * self.c.g[kp1];
-        let c1 = self.col(1);
+        let (p, yp, phi1) = (&mut self.p[..n], &self.yp[..n], &self.phi[..n]);
         if self.nornd {
-            for l in 0..n {
-                self.y_new[l] = self.p[l] + temp1 * (self.yp[l] - self.phi[c1 + l]);
+            for (((y, p), yp), phi1) in self.y_new.iter_mut().zip(&*p).zip(yp).zip(phi1) {
+                *y = p + temp1 * (yp - phi1);
             }
         } else {
-            let c16 = self.col(16);
-            for l in 0..n {
-                let rho = temp1 * (self.yp[l] - self.phi[c1 + l]) - self.phi[c16 + l];
-                self.y_new[l] = self.p[l] + rho;
-                self.p[l] = (self.y_new[l] - self.p[l]) - rho;
+            let c16 = &self.phi[15 * n..16 * n];
+            for ((((y, p), yp), phi1), c16) in self
+                .y_new
+                .iter_mut()
+                .zip(p.iter_mut())
+                .zip(yp)
+                .zip(phi1)
+                .zip(c16)
+            {
+                let rho = temp1 * (yp - phi1) - c16;
+                *y = *p + rho;
+                *p = (*y - *p) - rho;
             }
         }
         let (x, y_new, yp) = (self.x, &self.y_new, &mut self.yp);
@@ -342,18 +442,24 @@ impl Adams {
         self.hold = h;
         std::mem::swap(&mut self.y, &mut self.y_new);
         if !self.nornd {
-            let c15 = self.col(15);
-            self.phi[c15..c15 + n].copy_from_slice(&self.p);
+            self.phi[14 * n..15 * n].copy_from_slice(&self.p);
         }
-        let (ck1, ck2) = (self.col(kp1), self.col(kp2));
-        for l in 0..n {
-            self.phi[ck1 + l] = self.yp[l] - self.phi[c1 + l];
-            self.phi[ck2 + l] = self.phi[ck1 + l] - self.phi[ck2 + l];
+        // phi_{k+1} = f - phi_1, phi_{k+2} = phi_{k+1} - phi_{k+2}, then
+        // phi_i += phi_{k+1} for i = 1..=k.
+        let (lo, hi) = self.phi[..kp2 * n].split_at_mut(k * n);
+        let (ck1, ck2) = hi.split_at_mut(n);
+        for (((a, b), yp), phi1) in ck1
+            .iter_mut()
+            .zip(ck2.iter_mut())
+            .zip(&self.yp)
+            .zip(&lo[..n])
+        {
+            *a = yp - phi1;
+            *b = *a - *b;
         }
-        for i in 1..=k {
-            let ci = self.col(i);
-            for l in 0..n {
-                self.phi[ci + l] += self.phi[ck1 + l];
+        for col in lo.chunks_exact_mut(n) {
+            for (x, d) in col.iter_mut().zip(&*ck1) {
+                *x += d;
             }
         }
         self.select_order_and_step(est, p5eps);
