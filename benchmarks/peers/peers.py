@@ -4,7 +4,8 @@ Run through `run.sh` (which makes the virtual environment and builds pfaff); see
 README beside this file for what each column means. Usage:
 
     python peers.py --pfaff PATH [--models pendulum,andrews] [--tols 1e-4,...,1e-12]
-                    [--repeat 5] [--budget 2] [--output results.md]
+                    [--pfaff-tols 1e-2,3e-3,...,1e-13] [--repeat 5] [--budget 2]
+                    [--output results.md]
 """
 
 import argparse
@@ -348,8 +349,11 @@ def rhs_table(pfaff, model, compiled, ctypes_rhs, rows, tol):
 # --------------------------------------------------------------------------------------
 
 
-def row(model, tool, tol, error, evals, wall, failure):
-    return {"model": model.name, "tool": tool, "tol": tol, "error": error, "evals": evals, "wall": wall, "failure": failure}
+def row(model, tool, tol, error, evals, wall, failure, extra=False):
+    """One run; `extra`: a pfaff run at a tolerance the peers were not run at (a
+    candidate of the equal-accuracy comparison, listed in its own table)."""
+    return {"model": model.name, "tool": tool, "tol": tol, "error": error, "evals": evals, "wall": wall,
+            "failure": failure, "extra": extra}  # fmt: skip
 
 
 def fmt_e(x):
@@ -388,6 +392,8 @@ def render(rows):
         "|---|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for r in rows:
+        if r["extra"]:
+            continue
         if r["equal"] is None:
             equal = "—" if not r["tool"].startswith("pfaff") else ""
         else:
@@ -399,6 +405,18 @@ def render(rows):
             f"| {r['model']} | {r['tool']} | {r['tol']:.0e} | {error} | {r['evals']} | {wall} | "
             f"{fmt_ratio(r['wall_ratio'])} | {fmt_ratio(r['error_ratio'])} | {equal} |"
         )
+    return "\n".join(lines)
+
+
+def render_extra(rows):
+    lines = [
+        "| model | pfaff method | rtol = atol | error | rhs evals | wall [ms] |",
+        "|---|---|---:|---:|---:|---:|",
+    ]
+    for r in sorted((r for r in rows if r["extra"]), key=lambda r: (r["model"], r["tool"], -r["tol"])):
+        wall = "—" if r["failure"] else f"{r['wall'] * 1e3:.3g}"
+        error = f"failed: {r['failure']}" if r["failure"] else fmt_e(r["error"])
+        lines.append(f"| {r['model']} | {r['tool'].removeprefix('pfaff ')} | {r['tol']:.0e} | {error} | {r['evals']} | {wall} |")
     return "\n".join(lines)
 
 
@@ -470,6 +488,9 @@ def main():
     parser.add_argument("--pfaff", required=True, help="path of the release `pfaff` binary")
     parser.add_argument("--models", default="pendulum,andrews,car_axis")
     parser.add_argument("--tols", default=",".join(f"1e-{k}" for k in range(4, 13)))
+    parser.add_argument("--pfaff-tols", default=",".join(f"1e-{k},3e-{k + 1}" for k in range(2, 13)) + ",1e-13",
+                        help="pfaff is also run at these tolerances (default: half decades from 1e-2 to "
+                             "1e-13), as candidates of the equal-accuracy comparison")  # fmt: skip
     parser.add_argument("--repeat", type=int, default=5, help="timed repetitions (best is kept)")
     parser.add_argument("--budget", type=float, default=2.0,
                         help="a run longer than this many seconds is timed once")  # fmt: skip
@@ -515,6 +536,11 @@ def main():
             model_rows += pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget)
             model_rows += scipy_rows(model, ctypes_rhs, tol, args.repeat, args.budget)
             model_rows += sundials_rows(ca, model, compiled, tol, args.repeat, args.budget)
+        extra = [float(t) for t in args.pfaff_tols.split(",") if float(t) not in tols]
+        for tol in extra:
+            print(f"{name}: pfaff at rtol = atol = {tol:.0e}", file=sys.stderr)
+            for r in pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget):
+                model_rows.append({**r, "extra": True})
         near = min(tols, key=lambda t: abs(math.log10(t / args.rhs_tol)))
         rhs[name] = rhs_table(args.pfaff, model, compiled, ctypes_rhs, model_rows, near)
         rows += model_rows
@@ -529,13 +555,19 @@ def main():
         "pendulum against its closed form, andrews and car_axis against the test-set references), "
         "right-hand-side evaluations and wall time (best of several runs). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
-        "with the fastest pfaff run of this table, any method and tolerance, that is at least as accurate.",
+        "with the fastest pfaff run, any method and tolerance (this table's and those of the half-decade "
+        "table below), that is at least as accurate.",
         *notes,
         render(rows),
         "## At equal accuracy",
         "The last column of the table by tolerance: a peer's wall time over that of the fastest pfaff run "
         "(any method, any tolerance) at least as accurate; above 1 pfaff is faster, `—`: no pfaff run as accurate.",
         render_equal(rows, tols),
+        "## pfaff between the decades",
+        "pfaff alone at the tolerances of `--pfaff-tols` the peers were not run at (half decades): "
+        "candidates of the comparison at equal accuracy, so that the pfaff run it picks is not much more "
+        "accurate, and slower, than the peer's run only because the decades are far apart.",
+        render_extra(rows),
         "## One right-hand side",
         "Alone: the index-1 right-hand side (M, Q, C_q, gamma and the augmented solve) at the "
         "initial state. In a run: the run's wall time divided by its right-hand-side evaluations "
