@@ -20,6 +20,30 @@
 
 use super::dense::{power_of_two_inverse, Pivots};
 
+/// Largest size with kernels unrolled for it (`N` a constant: no loop control, no
+/// bounds checks in the inner loops); the loops of [`SmallCholesky`] serve the larger
+/// ones.
+const FIXED: usize = 10;
+
+/// `Some(f::<n>(args))` when `n` is at most [`FIXED`], `None` otherwise.
+macro_rules! fixed {
+    ($n:expr, $f:ident ( $($arg:expr),* )) => {
+        match $n {
+            1 => Some($f::<1>($($arg),*)),
+            2 => Some($f::<2>($($arg),*)),
+            3 => Some($f::<3>($($arg),*)),
+            4 => Some($f::<4>($($arg),*)),
+            5 => Some($f::<5>($($arg),*)),
+            6 => Some($f::<6>($($arg),*)),
+            7 => Some($f::<7>($($arg),*)),
+            8 => Some($f::<8>($($arg),*)),
+            9 => Some($f::<9>($($arg),*)),
+            FIXED => Some($f::<FIXED>($($arg),*)),
+            _ => None,
+        }
+    };
+}
+
 /// $PA = LU$ with partial (row) pivoting of an `n × n` matrix.
 #[derive(Clone, Debug)]
 pub(crate) struct SmallLu {
@@ -191,6 +215,10 @@ impl SmallCholesky {
         if n == 0 {
             return Pivots { max: 1.0, min: 1.0 };
         }
+        let (a, scale, inverse) = (&mut self.a, &mut self.scale, &mut self.inverse);
+        if let Some(p) = fixed!(n, factor_fixed(a, scale, inverse)) {
+            return p;
+        }
         let a = &mut self.a[..n * n];
         let scale = &mut self.scale[..n];
         for (i, s) in scale.iter_mut().enumerate() {
@@ -237,6 +265,10 @@ impl SmallCholesky {
     /// Solves $A x = b$ in place with the last factorization.
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.n;
+        let (a, scale, inverse) = (&self.a, &self.scale, &self.inverse);
+        if fixed!(n, solve_fixed(a, scale, inverse, b)).is_some() {
+            return;
+        }
         let a = &self.a[..n * n];
         let b = &mut b[..n];
         let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
@@ -273,6 +305,10 @@ impl SmallCholesky {
     /// columns are solved side by side.
     pub fn solve_rows(&self, x: &mut [f64], k: usize) {
         let n = self.n;
+        let (a, scale, inverse) = (&self.a, &self.scale, &self.inverse);
+        if fixed!(n, solve_rows_fixed(a, scale, inverse, x, k)).is_some() {
+            return;
+        }
         let a = &self.a[..n * n];
         let x = &mut x[..n * k];
         let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
@@ -304,6 +340,115 @@ impl SmallCholesky {
         }
         for (row, s) in x.chunks_exact_mut(k).zip(scale) {
             row.iter_mut().for_each(|v| *v *= s);
+        }
+    }
+}
+
+/// [`SmallCholesky::factor`] for `N × N` (same operations, in a local array).
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn factor_fixed<const N: usize>(a: &mut [f64], scale: &mut [f64], inverse: &mut [f64]) -> Pivots {
+    let (a, scale, inverse) = (&mut a[..N * N], &mut scale[..N], &mut inverse[..N]);
+    let mut l = [[0.0_f64; N]; N];
+    for i in 0..N {
+        scale[i] = power_of_two_inverse(a[i * N + i].abs().sqrt());
+    }
+    for i in 0..N {
+        for j in 0..=i {
+            l[i][j] = a[i * N + j] * (scale[i] * scale[j]);
+        }
+    }
+    let (mut max, mut min) = (0.0_f64, f64::INFINITY);
+    for i in 0..N {
+        for j in 0..i {
+            let mut s = 0.0;
+            for k in 0..j {
+                s += l[i][k] * l[j][k];
+            }
+            l[i][j] = (l[i][j] - s) * inverse[j];
+        }
+        let mut s = 0.0;
+        for k in 0..i {
+            s += l[i][k] * l[i][k];
+        }
+        let d = l[i][i] - s;
+        if d.is_nan() || d <= 0.0 {
+            return Pivots {
+                max: max.max(d.abs()),
+                min: 0.0,
+            };
+        }
+        max = max.max(d);
+        min = min.min(d);
+        let v = d.sqrt();
+        l[i][i] = v;
+        inverse[i] = 1.0 / v;
+    }
+    for i in 0..N {
+        for j in 0..N {
+            a[i * N + j] = if j <= i { l[i][j] } else { l[j][i] };
+        }
+    }
+    Pivots { max, min }
+}
+
+/// The substitutions of [`SmallCholesky::solve`] for `N × N` on the scaled `x`.
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn substitute_fixed<const N: usize>(a: &[f64], inverse: &[f64], x: &mut [f64; N]) {
+    let (a, inverse) = (&a[..N * N], &inverse[..N]);
+    for j in 0..N {
+        let xj = x[j] * inverse[j];
+        x[j] = xj;
+        for i in j + 1..N {
+            x[i] -= a[j * N + i] * xj;
+        }
+    }
+    for i in (0..N).rev() {
+        let xi = x[i] * inverse[i];
+        x[i] = xi;
+        for j in 0..i {
+            x[j] -= a[i * N + j] * xi;
+        }
+    }
+}
+
+/// [`SmallCholesky::solve`] for `N × N`.
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn solve_fixed<const N: usize>(a: &[f64], scale: &[f64], inverse: &[f64], b: &mut [f64]) {
+    let (b, scale) = (&mut b[..N], &scale[..N]);
+    let mut x = [0.0_f64; N];
+    for i in 0..N {
+        x[i] = b[i] * scale[i];
+    }
+    substitute_fixed(a, inverse, &mut x);
+    for i in 0..N {
+        b[i] = x[i] * scale[i];
+    }
+}
+
+/// [`SmallCholesky::solve_rows`] for `N × N`: column by column, each one unrolled
+/// (the columns' chains are independent, so consecutive ones overlap).
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn solve_rows_fixed<const N: usize>(
+    a: &[f64],
+    scale: &[f64],
+    inverse: &[f64],
+    x: &mut [f64],
+    k: usize,
+) {
+    let (x, scale) = (&mut x[..N * k], &scale[..N]);
+    for c in 0..k {
+        let mut col = [0.0_f64; N];
+        for i in 0..N {
+            col[i] = x[i * k + c] * scale[i];
+        }
+        substitute_fixed(a, inverse, &mut col);
+        for i in 0..N {
+            x[i * k + c] = col[i] * scale[i];
         }
     }
 }
@@ -384,6 +529,68 @@ mod tests {
                         (xs[3 * i + c] - f * xi).abs() <= 8.0 * f64::EPSILON * xi.abs().max(1.0),
                         "Cholesky columns n = {n}"
                     );
+                }
+            }
+        }
+    }
+
+    /// The Cholesky solves agree with the
+    /// independent partial-pivoting LU on symmetric positive definite matrices of the
+    /// sizes of a mechanism's Gram matrices, `n` = 1 to 12, some with scales spread
+    /// over twelve orders of magnitude (which equilibration removes): the two solutions
+    /// to a few units of round-off times the condition of the equilibrated matrix.
+    #[test]
+    fn cholesky_solves_agree_with_lu() {
+        for n in 1..=12_usize {
+            for spread in [0.0, 12.0] {
+                // A = D (BᵀB + I) D with B from a sine, D = 10^(spread·i/n).
+                #[allow(clippy::cast_precision_loss)]
+                let d: Vec<f64> = (0..n)
+                    .map(|i| 10f64.powf(spread * i as f64 / n as f64))
+                    .collect();
+                #[allow(clippy::cast_precision_loss)]
+                let bm: Vec<f64> = (0..n * n).map(|k| (1.3 * k as f64 + 0.4).sin()).collect();
+                let a: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        let (i, j) = (k / n, k % n);
+                        let s: f64 = (0..n).map(|r| bm[r * n + i] * bm[r * n + j]).sum();
+                        d[i] * d[j] * (s + if i == j { 1.0 } else { 0.0 })
+                    })
+                    .collect();
+                let mut ch = SmallCholesky::new(n);
+                ch.matrix_mut().copy_from_slice(&a);
+                assert!(ch.factor().ratio() > 0.0);
+                let mut lu = SmallLu::new(n);
+                lu.matrix_mut().copy_from_slice(&a);
+                assert!(lu.factor().ratio() > 0.0);
+                // Three right-hand sides: a cosine, a unit vector, all ones.
+                #[allow(clippy::cast_precision_loss)]
+                let cols: Vec<Vec<f64>> = vec![
+                    (0..n).map(|i| (i as f64).cos()).collect(),
+                    (0..n).map(|i| if i == n / 2 { 1.0 } else { 0.0 }).collect(),
+                    vec![1.0; n],
+                ];
+                let mut rows: Vec<f64> = (0..n)
+                    .flat_map(|i| cols.iter().map(move |c| c[i]))
+                    .collect();
+                ch.solve_rows(&mut rows, 3);
+                for (c, b) in cols.iter().enumerate() {
+                    let (mut x, mut y) = (b.clone(), b.clone());
+                    ch.solve(&mut x);
+                    lu.solve(&mut y);
+                    for i in 0..n {
+                        // Relative to the solution's size in the equilibrated units.
+                        let size = (0..n).map(|j| (y[j] * d[j]).abs()).fold(0.0, f64::max);
+                        let err = ((x[i] - y[i]) * d[i]).abs();
+                        #[allow(clippy::cast_precision_loss)]
+                        let tol = 1e3 * f64::EPSILON * size * (n * n) as f64;
+                        assert!(
+                            err <= tol,
+                            "solve n = {n} spread {spread}: {err:e} > {tol:e}"
+                        );
+                        let err = ((rows[3 * i + c] - x[i]) * d[i]).abs();
+                        assert!(err <= tol, "solve_rows n = {n} spread {spread}: {err:e}");
+                    }
                 }
             }
         }

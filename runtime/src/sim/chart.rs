@@ -42,6 +42,7 @@
 use super::point::{Point, REFIT_RATIO};
 use crate::linalg::inf_norm;
 use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::scale;
 use crate::workspace::EvalError;
 use crate::{Info, Mechanism};
 
@@ -82,15 +83,14 @@ impl From<EvalError> for ChartFailure {
     }
 }
 
-/// A chart anchored at an accepted state, with the Newton scratch.
+/// The maps of one anchor: where they were made, its Jacobian and the explicit
+/// inverses of its Gram matrices.
 #[derive(Debug)]
-pub(crate) struct Chart {
+struct Maps {
     /// The anchor $q_a$.
     anchor: Vec<f64>,
     /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows[..rows_h]`.
     normals: Vec<f64>,
-    /// The factorization of a Gram matrix, scratch for the maps.
-    gram: SmallCholesky,
     /// $(N N^\mathsf{T})^{-1}N$, row-major `r × n` (its transpose is the map $P$).
     position_map: Vec<f64>,
     /// $G_a^{-1} = (J_a J_a^\mathsf{T})^{-1}$ of every projected row (holonomic and
@@ -99,6 +99,119 @@ pub(crate) struct Chart {
     velocity_map_regular: bool,
     /// For each constraint row, its place in `rows` (`usize::MAX` when not projected).
     slot: Vec<usize>,
+    /// The rows of the point's projections when anchored (the first `rows_h`
+    /// holonomic), which the maps belong to; empty before the first anchor.
+    rows: Vec<usize>,
+    rows_h: usize,
+    /// The pivot ratio of $N N^\mathsf{T}$.
+    ratio: f64,
+    /// Whether `rows` are all the constraint rows in order (`slot` the identity).
+    all_rows: bool,
+}
+
+impl Maps {
+    fn new(n: usize, m: usize, r: usize) -> Self {
+        Self {
+            anchor: vec![0.0; n],
+            normals: vec![0.0; m * n],
+            position_map: vec![0.0; n * r],
+            velocity_map: vec![0.0; m * m],
+            velocity_map_regular: false,
+            slot: vec![usize::MAX; m],
+            rows: Vec::with_capacity(m),
+            rows_h: 0,
+            ratio: f64::NAN,
+            all_rows: false,
+        }
+    }
+
+    /// Makes the maps at the current positions of `p` (its dense $J$ there), with
+    /// `gram` as scratch; returns the pivot ratio of $N N^\mathsf{T}$.
+    fn make<M: Mechanism + ?Sized>(
+        &mut self,
+        gram: &mut SmallCholesky,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<f64, EvalError> {
+        self.normals.copy_from_slice(p.dense_jacobian(t)?);
+        self.anchor.copy_from_slice(&p.q);
+        self.rows.clear();
+        self.rows.extend_from_slice(&p.rows);
+        self.rows_h = p.rows_h;
+        let (n, r, m) = (p.q.len(), p.rows_h, p.rows.len());
+        if self.position_map.len() != n * r || self.velocity_map.len() != m * m {
+            // Assembly dropped redundant rows (allocates, once).
+            self.position_map = vec![0.0; n * r];
+            self.velocity_map = vec![0.0; m * m];
+        }
+        self.slot.fill(usize::MAX);
+        for (k, &i) in self.rows.iter().enumerate() {
+            self.slot[i] = k;
+        }
+        self.all_rows = self.rows.len() == self.slot.len()
+            && self.rows.iter().enumerate().all(|(k, &i)| k == i);
+        let identity = |map: &mut [f64]| {
+            map.fill(0.0);
+            for k in 0..m {
+                map[k * m + k] = 1.0;
+            }
+        };
+        if m > r {
+            gram.resize(m);
+            let ratio = gram_cholesky(gram, &self.normals, &self.rows, n);
+            identity(&mut self.velocity_map);
+            gram.solve_rows(&mut self.velocity_map, m);
+            self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
+        }
+        gram.resize(r);
+        let ratio = normal_map(
+            gram,
+            &mut self.position_map,
+            &self.normals,
+            &self.rows[..r],
+            n,
+        );
+        if m == r {
+            identity(&mut self.velocity_map);
+            gram.solve_rows(&mut self.velocity_map, m);
+            self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
+        }
+        self.ratio = ratio;
+        Ok(ratio)
+    }
+
+    /// Whether the velocity iteration with these maps serves the rows of `p` (see
+    /// [`Chart::serves`]).
+    fn serves<M: Mechanism + ?Sized>(&self, p: &Point<'_, M>) -> bool {
+        self.velocity_map_regular
+            && self.rows == p.rows
+            && self.rows_h == p.rows_h
+            && p.rows_h == p.info.nh()
+    }
+
+    /// The distance $\lVert q - q_a\rVert_\infty$ of positions `q` from the anchor.
+    fn distance(&self, q: &[f64]) -> f64 {
+        q.iter()
+            .zip(&self.anchor)
+            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()))
+    }
+}
+
+/// A chart anchored at an accepted state, with the Newton scratch.
+///
+/// Besides the anchor's maps it holds the maps *staged* by [`Chart::stage`] at a kept
+/// state before its polish: [`Chart::anchor_staged`] takes them as the next anchor
+/// when the state is accepted, so that an accepted step factors one Gram matrix.
+#[derive(Debug)]
+pub(crate) struct Chart {
+    maps: Maps,
+    staged: Maps,
+    /// The time and the polished positions of the kept state the staged maps were
+    /// made for (`None`: no staged maps).
+    staged_for: Option<f64>,
+    staged_q: Vec<f64>,
+    /// The factorization of a Gram matrix, scratch for the maps.
+    gram: SmallCholesky,
     /// $G_a^{-1}$ times the velocity residuals.
     nu: Vec<f64>,
     /// The velocity residuals of every constraint row.
@@ -107,10 +220,6 @@ pub(crate) struct Chart {
     mu: Vec<f64>,
     /// The current update.
     dx: Vec<f64>,
-    /// The rows of the point's projections when anchored (the first `rows_h`
-    /// holonomic), which the maps belong to; empty before the first anchor.
-    rows: Vec<usize>,
-    rows_h: usize,
     /// Measured contraction rate per unit distance from the anchor.
     rate_per_distance: Option<f64>,
     /// The same, measured on the velocities' iteration.
@@ -163,24 +272,23 @@ fn update(
     (step, weighted)
 }
 
+/// Most chord updates of [`Chart::polish`] before it hands over to Newton.
+const POLISH_ITERATIONS: usize = 4;
+
 impl Chart {
     /// Scratch for a model with `n` coordinates and `m` constraint rows, of which `r`
     /// independent holonomic ones, for the integrator's tolerances `rtol`, `atol`.
     pub fn new(n: usize, m: usize, r: usize, rtol: f64, atol: f64) -> Self {
         Self {
-            anchor: vec![0.0; n],
-            normals: vec![0.0; m * n],
+            maps: Maps::new(n, m, r),
+            staged: Maps::new(n, m, r),
+            staged_for: None,
+            staged_q: vec![0.0; n],
             gram: SmallCholesky::new(m),
-            position_map: vec![0.0; n * r],
-            velocity_map: vec![0.0; m * m],
-            velocity_map_regular: false,
-            slot: vec![usize::MAX; m],
             nu: vec![0.0; m],
             vel: vec![0.0; m],
             mu: vec![0.0; m],
             dx: vec![0.0; n],
-            rows: Vec::with_capacity(m),
-            rows_h: 0,
             rate_per_distance: None,
             velocity_rate_per_distance: None,
             rtol,
@@ -200,48 +308,99 @@ impl Chart {
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<f64, EvalError> {
-        self.normals.copy_from_slice(p.dense_jacobian(t)?);
-        self.anchor.copy_from_slice(&p.q);
-        self.rows.clear();
-        self.rows.extend_from_slice(&p.rows);
-        self.rows_h = p.rows_h;
-        let (n, r, m) = (p.q.len(), p.rows_h, p.rows.len());
-        if self.position_map.len() != n * r || self.velocity_map.len() != m * m {
-            // Assembly dropped redundant rows (allocates, once).
-            self.position_map = vec![0.0; n * r];
-            self.velocity_map = vec![0.0; m * m];
+        self.staged_for = None;
+        self.maps.make(&mut self.gram, p, t)
+    }
+
+    /// Makes the maps of the current positions of `p` (a kept state as reconstructed,
+    /// on the manifold to the integrator's tolerance) as the staged ones, for
+    /// [`polish`](Self::polish) and [`correct_velocities_staged`](Self::correct_velocities_staged)
+    /// to use and [`anchor_staged`](Self::anchor_staged) to take; returns the pivot
+    /// ratio of $N N^\mathsf{T}$ and whether the staged maps serve the point.
+    pub fn stage<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<(f64, bool), EvalError> {
+        self.staged_for = None;
+        let ratio = self.staged.make(&mut self.gram, p, t)?;
+        Ok((ratio, self.staged.serves(p)))
+    }
+
+    /// Records that the staged maps belong to the kept state `(t, q)`.
+    pub fn stage_for(&mut self, t: f64, q: &[f64]) {
+        self.staged_for = Some(t);
+        self.staged_q.copy_from_slice(q);
+    }
+
+    /// Takes the staged maps as the anchor when they were staged for the state of `p`
+    /// at `t` (and its rows); returns their pivot ratio then, `None` otherwise.
+    ///
+    /// The anchor is then the kept state before its polish, off the manifold by the
+    /// chart's tolerance and as far from the polished state: the chart is the graph
+    /// over the tangent space of a point that need not lie on the manifold, its
+    /// conditioning and its contraction rates change by that relative amount.
+    pub fn anchor_staged<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &Point<'_, M>,
+        t: f64,
+    ) -> Option<f64> {
+        if self.staged_for != Some(t)
+            || self.staged_q != p.q
+            || self.staged.rows != p.rows
+            || self.staged.rows_h != p.rows_h
+        {
+            return None;
         }
-        self.slot.fill(usize::MAX);
-        for (k, &i) in self.rows.iter().enumerate() {
-            self.slot[i] = k;
-        }
-        let identity = |map: &mut [f64]| {
-            map.fill(0.0);
-            for k in 0..m {
-                map[k * m + k] = 1.0;
+        self.staged_for = None;
+        std::mem::swap(&mut self.maps, &mut self.staged);
+        Some(self.maps.ratio)
+    }
+
+    /// Polishes the positions of `p` onto the holonomic constraints to the relative
+    /// `tolerance` (as [`Point::project_positions`] decides it) by the chord iteration
+    /// with the staged position map: made at the first iterate, its first update is
+    /// Newton's, and from a residual at the chart's tolerance one update is the norm.
+    /// Returns the number of updates, or `None` when the iteration does not contract
+    /// within a few updates (for Newton to take over from where it stopped).
+    pub fn polish<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        tolerance: f64,
+    ) -> Result<Option<usize>, EvalError> {
+        let n = p.q.len();
+        let r = self.staged.rows_h;
+        let mut previous = f64::INFINITY;
+        for iteration in 0..=POLISH_ITERATIONS {
+            p.constraints(t)?;
+            p.dense_jacobian(t)?;
+            let size = scale::coordinate_size(&p.q);
+            let (c, jac) = (p.ws.constraints(), p.ws.jacobian());
+            let residual = inf_norm(c);
+            if scale::all_met(c, jac, n, tolerance, size)
+                || (residual >= 0.5 * previous && scale::at_rounding_floor(c, jac, n, size))
+            {
+                return Ok(Some(iteration));
             }
-        };
-        if m > r {
-            self.gram.resize(m);
-            let ratio = gram_cholesky(&mut self.gram, &self.normals, &self.rows, n);
-            identity(&mut self.velocity_map);
-            self.gram.solve_rows(&mut self.velocity_map, m);
-            self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
+            if iteration == POLISH_ITERATIONS || !residual.is_finite() || residual >= 0.5 * previous
+            {
+                return Ok(None);
+            }
+            previous = residual;
+            for (mu, &i) in self.mu.iter_mut().zip(&self.staged.rows[..r]) {
+                *mu = c[i];
+            }
+            update(
+                &self.staged.position_map,
+                &self.mu[..r],
+                &mut p.q,
+                &mut self.dx,
+                (self.rtol, self.atol),
+            );
+            p.newton_iterations += 1;
         }
-        self.gram.resize(r);
-        let ratio = normal_map(
-            &mut self.gram,
-            &mut self.position_map,
-            &self.normals,
-            &self.rows[..r],
-            n,
-        );
-        if m == r {
-            identity(&mut self.velocity_map);
-            self.gram.solve_rows(&mut self.velocity_map, m);
-            self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
-        }
-        Ok(ratio)
+        Ok(None)
     }
 
     /// Moves the positions of `p` along the anchor's normals onto $C_R(q, t) = 0$
@@ -252,11 +411,8 @@ impl Chart {
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<usize, ChartFailure> {
-        let rows_h = self.rows_h;
-        let distance =
-            p.q.iter()
-                .zip(&self.anchor)
-                .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        let rows_h = self.maps.rows_h;
+        let distance = self.maps.distance(&p.q);
         let mut rate = self
             .rate_per_distance
             .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
@@ -264,7 +420,7 @@ impl Chart {
         let mut previous: Option<f64> = None;
         for iteration in 0..=MAX_ITERATIONS {
             p.constraints(t)?;
-            let (c, rows) = (p.ws.constraints(), &self.rows[..rows_h]);
+            let (c, rows) = (p.ws.constraints(), &self.maps.rows[..rows_h]);
             let mut residual = 0.0_f64;
             for (mu, &i) in self.mu.iter_mut().zip(rows) {
                 *mu = c[i];
@@ -285,7 +441,13 @@ impl Chart {
                     residual,
                 });
             }
-            let (step, weighted) = self.update(&mut p.q, rows_h);
+            let (step, weighted) = update(
+                &self.maps.position_map,
+                &self.mu[..rows_h],
+                &mut p.q,
+                &mut self.dx,
+                (self.rtol, self.atol),
+            );
             // An update at round-off has converged, whatever rate its noise suggests.
             if step <= floor {
                 return Ok(iteration + 1);
@@ -312,17 +474,6 @@ impl Chart {
         unreachable!("the loop returns at MAX_ITERATIONS")
     }
 
-    /// [`update`] with the position map and the first `r` residuals of `mu`.
-    fn update(&mut self, x: &mut [f64], r: usize) -> (f64, f64) {
-        update(
-            &self.position_map,
-            &self.mu[..r],
-            x,
-            &mut self.dx,
-            (self.rtol, self.atol),
-        )
-    }
-
     /// Projects the velocities of `p` orthogonally onto the velocity constraints at its
     /// positions by the chord iteration of the module docs, until the estimated
     /// remaining error is below `kappa` in the integrator's weights or at round-off;
@@ -335,7 +486,28 @@ impl Chart {
         t: f64,
         kappa: f64,
     ) -> Result<Option<usize>, EvalError> {
-        if !self.serves(p) {
+        self.correct_velocities_with(p, t, kappa, false)
+    }
+
+    /// [`correct_velocities`](Self::correct_velocities) to round-off with the staged
+    /// maps (see [`stage`](Self::stage)).
+    pub fn correct_velocities_staged<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+    ) -> Result<Option<usize>, EvalError> {
+        self.correct_velocities_with(p, t, 0.0, true)
+    }
+
+    fn correct_velocities_with<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &mut Point<'_, M>,
+        t: f64,
+        kappa: f64,
+        staged: bool,
+    ) -> Result<Option<usize>, EvalError> {
+        let maps = if staged { &self.staged } else { &self.maps };
+        if !maps.serves(p) {
             return Ok(None);
         }
         p.velocity_residuals(t)?;
@@ -346,8 +518,8 @@ impl Chart {
             ct: &ws.ct,
             bias: &ws.bias,
         };
-        let distance = self.distance(&p.q);
-        Ok(self.project_velocities(p.info, terms, distance, &mut p.qd, kappa))
+        let distance = maps.distance(&p.q);
+        Ok(self.iterate_velocities(p.info, terms, distance, &mut p.qd, kappa, staged))
     }
 
     /// Whether the velocity iteration serves the rows of `p`: the maps are regular and
@@ -356,17 +528,12 @@ impl Chart {
     /// checks at the point, renewing them when it falls, and maps made at the anchor
     /// cannot).
     pub fn serves<M: Mechanism + ?Sized>(&self, p: &Point<'_, M>) -> bool {
-        self.velocity_map_regular
-            && self.rows == p.rows
-            && self.rows_h == p.rows_h
-            && p.rows_h == p.info.nh()
+        self.maps.serves(p)
     }
 
     /// The distance $\lVert q - q_a\rVert_\infty$ of positions `q` from the anchor.
     pub fn distance(&self, q: &[f64]) -> f64 {
-        q.iter()
-            .zip(&self.anchor)
-            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()))
+        self.maps.distance(q)
     }
 
     /// The iteration of [`correct_velocities`](Self::correct_velocities) on `qd` at
@@ -380,77 +547,149 @@ impl Chart {
         qd: &mut [f64],
         kappa: f64,
     ) -> Option<usize> {
-        let m = self.rows.len();
-        if m == 0 {
-            return Some(0);
-        }
-        let mut rate = self
+        self.iterate_velocities(info, terms, distance, qd, kappa, false)
+    }
+
+    fn iterate_velocities(
+        &mut self,
+        info: &Info,
+        terms: VelocityTerms<'_>,
+        distance: f64,
+        qd: &mut [f64],
+        kappa: f64,
+        staged: bool,
+    ) -> Option<usize> {
+        let maps = if staged { &self.staged } else { &self.maps };
+        let rate = self
             .velocity_rate_per_distance
             .or(self.rate_per_distance)
             .map_or(UNKNOWN_RATE, |r| (r * distance).min(UNKNOWN_RATE));
-        let mh = info.nh();
-        let mut previous: Option<f64> = None;
-        for iteration in 0..MAX_ITERATIONS {
-            // The residuals J q̇ + [C_t; g] of the rows.
-            self.vel[..mh].copy_from_slice(terms.ct);
-            self.vel[mh..].copy_from_slice(terms.bias);
-            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
-                self.vel[r as usize] += v * qd[c as usize];
-            }
-            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
-                self.vel[mh + r as usize] += v * qd[c as usize];
-            }
-            for (mu, &i) in self.mu.iter_mut().zip(&self.rows) {
-                *mu = self.vel[i];
-            }
-            // ν = G_a⁻¹ μ, Δq̇ = Jᵀν.
-            let mu = &self.mu[..m];
-            for (nu, row) in self.nu.iter_mut().zip(self.velocity_map.chunks_exact(m)) {
-                *nu = row.iter().zip(mu).map(|(a, b)| a * b).sum();
-            }
-            let dx = &mut self.dx;
-            dx.fill(0.0);
-            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
-                if let Some(nu) = self.nu.get(self.slot[r as usize]) {
-                    dx[c as usize] += v * nu;
-                }
-            }
-            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
-                if let Some(nu) = self.nu.get(self.slot[mh + r as usize]) {
-                    dx[c as usize] += v * nu;
-                }
-            }
-            let floor = 8.0 * f64::EPSILON * inf_norm(qd);
-            let (mut step, mut weighted) = (0.0_f64, 0.0_f64);
-            for (xj, d) in qd.iter_mut().zip(&*dx) {
-                *xj -= d;
-                step = step.max(d.abs());
-                weighted = weighted.max(d.abs() / (self.atol + self.rtol * xj.abs()));
-            }
-            if step <= floor {
-                return Some(iteration + 1);
-            }
-            if !step.is_finite() {
-                return None;
-            }
-            if let Some(p) = previous {
-                let measured = weighted / p;
-                if measured.is_nan() || measured >= DIVERGENCE {
-                    return None;
-                }
-                rate = measured;
-                if step > 100.0 * floor && distance > 0.0 {
-                    self.velocity_rate_per_distance = Some(measured / distance);
-                }
-            }
-            let left = rate / (1.0 - rate);
-            if left * weighted <= kappa || left * step <= floor {
-                return Some(iteration + 1);
-            }
-            previous = Some(weighted);
+        let scratch = Scratch {
+            nu: &mut self.nu,
+            vel: &mut self.vel,
+            mu: &mut self.mu,
+            dx: &mut self.dx,
+        };
+        let (updates, measured) = velocity_iteration(
+            maps,
+            scratch,
+            info,
+            terms,
+            qd,
+            (rate, kappa),
+            (self.rtol, self.atol),
+        );
+        if let Some(measured) = measured.filter(|_| distance > 0.0) {
+            self.velocity_rate_per_distance = Some(measured / distance);
         }
-        None
+        updates
     }
+}
+
+/// The chart's scratch vectors for [`velocity_iteration`].
+struct Scratch<'a> {
+    nu: &'a mut [f64],
+    vel: &'a mut [f64],
+    mu: &'a mut [f64],
+    dx: &'a mut [f64],
+}
+
+/// The velocity iteration of [`Chart::correct_velocities`] with the maps `maps`, from
+/// the contraction rate `rate`, to `kappa`; returns the number of updates (`None`:
+/// not contracting) and the rate measured on updates above round-off.
+fn velocity_iteration(
+    maps: &Maps,
+    s: Scratch<'_>,
+    info: &Info,
+    terms: VelocityTerms<'_>,
+    qd: &mut [f64],
+    (mut rate, kappa): (f64, f64),
+    (rtol, atol): (f64, f64),
+) -> (Option<usize>, Option<f64>) {
+    let m = maps.rows.len();
+    if m == 0 {
+        return (Some(0), None);
+    }
+    let mh = info.nh();
+    let (vel, mu, nu, dx) = (&mut s.vel[..], &mut s.mu[..m], &mut s.nu[..m], &mut *s.dx);
+    let mut previous: Option<f64> = None;
+    let mut rate_measured = None;
+    for iteration in 0..MAX_ITERATIONS {
+        // The residuals J q̇ + [C_t; g] of the rows.
+        vel[..mh].copy_from_slice(terms.ct);
+        vel[mh..].copy_from_slice(terms.bias);
+        for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
+            vel[r as usize] += v * qd[c as usize];
+        }
+        let vn = &mut vel[mh..];
+        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
+            vn[r as usize] += v * qd[c as usize];
+        }
+        // ν = G_a⁻¹ μ, Δq̇ = Jᵀν.
+        let dense = maps.all_rows;
+        if dense {
+            mu.copy_from_slice(&vel[..m]);
+        } else {
+            for (mu, &i) in mu.iter_mut().zip(&maps.rows) {
+                *mu = vel[i];
+            }
+        }
+        for (nu, row) in nu.iter_mut().zip(maps.velocity_map.chunks_exact(m)) {
+            *nu = row.iter().zip(&*mu).map(|(a, b)| a * b).sum();
+        }
+        dx.fill(0.0);
+        if dense {
+            let (nh, nn) = nu.split_at(mh);
+            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
+                dx[c as usize] += v * nh[r as usize];
+            }
+            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
+                dx[c as usize] += v * nn[r as usize];
+            }
+        } else {
+            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
+                if let Some(nu) = nu.get(maps.slot[r as usize]) {
+                    dx[c as usize] += v * nu;
+                }
+            }
+            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
+                if let Some(nu) = nu.get(maps.slot[mh + r as usize]) {
+                    dx[c as usize] += v * nu;
+                }
+            }
+        }
+        let (mut step, mut weighted, mut size) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for (xj, d) in qd.iter_mut().zip(&*dx) {
+            size = size.max(xj.abs());
+            *xj -= d;
+            step = step.max(d.abs());
+            weighted = weighted.max(d.abs() / (atol + rtol * xj.abs()));
+        }
+        // The round-off of q̇ (its size before the update, as measured before).
+        let floor = 8.0 * f64::EPSILON * size;
+        if step <= floor {
+            return (Some(iteration + 1), rate_measured);
+        }
+        if !step.is_finite() {
+            return (None, rate_measured);
+        }
+        if let Some(p) = previous {
+            let measured = weighted / p;
+            if measured.is_nan() || measured >= DIVERGENCE {
+                return (None, rate_measured);
+            }
+            rate = measured;
+            if step > 100.0 * floor {
+                rate_measured = Some(measured);
+            }
+        }
+        let left = rate / (1.0 - rate);
+        if left * weighted <= kappa || left * step <= floor {
+            return (Some(iteration + 1), rate_measured);
+        }
+        previous = Some(weighted);
+    }
+    (None, rate_measured)
 }
 
 /// The pattern values of $C_q$ and $G$ and the rates $C_t$, $g$ at a point, for the

@@ -128,6 +128,9 @@ pub(crate) struct Partitioned {
     /// Whether the velocities of the point are still to be projected (with the
     /// dynamics terms, in [`Form::accelerations`]).
     pending: bool,
+    /// Whether the last kept state was left off the chart by
+    /// [`reconstruct_kept`](Form::reconstruct_kept) (its chord did not converge).
+    off_chart: bool,
 }
 
 impl Partitioned {
@@ -141,14 +144,22 @@ impl Partitioned {
             cached: None,
             y_cached: vec![0.0; 2 * n],
             pending: false,
+            off_chart: false,
         }
+    }
+
+    /// Whether a pivot ratio of $N N^\mathsf{T}$ calls for renewing the kept rows (see
+    /// [`REFIT_FRACTION`]).
+    fn worse(&self, ratio: f64) -> bool {
+        ratio.is_nan() || ratio <= REFIT_RATIO || ratio < REFIT_FRACTION * self.fit_ratio
     }
 }
 
 impl Form for Partitioned {
     const CORRECTION: Correction = Correction::SameDerivative;
 
-    /// Anchors the chart of the next step at the accepted state.
+    /// Anchors the chart of the next step at the accepted state: the maps
+    /// [`keep`](Form::keep) staged for it when it was kept, made here otherwise.
     fn accept<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -160,12 +171,16 @@ impl Form for Partitioned {
         if p.rows.is_empty() {
             return Ok(());
         }
-        p.factorizations += 1;
         let eval = SimErrorKind::from_eval;
-        let mut ratio = self.chart.anchor(p, t).map_err(eval)?;
-        let worse =
-            ratio.is_nan() || ratio <= REFIT_RATIO || ratio < REFIT_FRACTION * self.fit_ratio;
-        if worse && p.refit(t) {
+        let mut ratio = match self.chart.anchor_staged(p, t) {
+            Some(ratio) => ratio,
+            None => {
+                p.factorizations += 1;
+                self.chart.anchor(p, t).map_err(eval)?
+            }
+        };
+        if self.worse(ratio) && p.refit(t) {
+            p.factorizations += 1;
             ratio = self.chart.anchor(p, t).map_err(eval)?;
             self.fit_ratio = ratio;
         }
@@ -286,17 +301,29 @@ impl Form for Partitioned {
         match self.reconstruct(p, t, y) {
             Err(SimErrorKind::NewtonFailed { .. }) => {
                 self.cached = None;
+                self.off_chart = true;
                 copy_state(p, y);
                 Ok(())
             }
-            r => r,
+            r => {
+                self.off_chart = false;
+                r
+            }
         }
     }
 
-    /// Polishes the chart's point to the Newton tolerance (positions by minimum-norm
-    /// Newton, then the velocities by the chart's chord iteration to round-off, the
-    /// same orthogonal projection): below the integrator's tolerance, so the
-    /// derivatives the integrator keeps stay valid.
+    /// Polishes the chart's point to the Newton tolerance, below the integrator's
+    /// tolerance, so the derivatives the integrator keeps stay valid.
+    ///
+    /// The maps of the next anchor are made first, at the point as reconstructed (its
+    /// $J$ came with the last evaluation), and staged ([`Chart::stage`]): the positions
+    /// are polished by the chord iteration with them (its first update is Newton's,
+    /// and one is the norm), the velocities by the chart's chord iteration with them
+    /// to round-off (the same orthogonal projection at the polished positions), and
+    /// [`accept`](Form::accept) takes them as the anchor. An accepted step thus factors
+    /// one Gram matrix and evaluates one $J$ (at the polished positions). Kept states
+    /// off the chart, ill-conditioned maps and models whose redundant constraints were
+    /// dropped take minimum-norm Newton and the anchor's iteration instead.
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -304,12 +331,37 @@ impl Form for Partitioned {
     ) -> Result<(), SimErrorKind> {
         self.cached = None;
         self.pending = false;
-        p.project_positions(t)?;
-        match self.chart.correct_velocities(p, t, 0.0) {
-            Ok(Some(_)) => Ok(()),
-            Ok(None) => p.project_velocities(t),
-            Err(e) => Err(SimErrorKind::from_eval(e)),
+        let eval = SimErrorKind::from_eval;
+        if p.rows.is_empty() {
+            return Ok(());
         }
+        let staged = if self.off_chart || p.rows_h != p.info.nh() {
+            false
+        } else {
+            p.factorizations += 1;
+            let (ratio, serves) = self.chart.stage(p, t).map_err(eval)?;
+            serves && !self.worse(ratio)
+        };
+        if !staged {
+            p.project_positions(t)?;
+            return match self.chart.correct_velocities(p, t, 0.0) {
+                Ok(Some(_)) => Ok(()),
+                Ok(None) => p.project_velocities(t),
+                Err(e) => Err(eval(e)),
+            };
+        }
+        if p.rows_h > 0 {
+            let tol = p.newton.tolerance;
+            if self.chart.polish(p, t, tol).map_err(eval)?.is_none() {
+                p.project_positions(t)?;
+            }
+        }
+        match self.chart.correct_velocities_staged(p, t).map_err(eval)? {
+            Some(_) => {}
+            None => p.project_velocities(t)?,
+        }
+        self.chart.stage_for(t, &p.q);
+        Ok(())
     }
 
     fn recoverable(&self, e: &SimErrorKind) -> bool {

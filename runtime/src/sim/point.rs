@@ -96,7 +96,12 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     pub vel: Vec<f64>,
     mu: Vec<f64>,
     lu_h: SmallCholesky,
+    /// Whether `lu_h` holds the factor of the last position update of a projection
+    /// whose projected rows are all holonomic (see [`Point::project`]).
+    position_factor: bool,
     lu_v: SmallCholesky,
+    /// Scratch of a velocity update.
+    dx: Vec<f64>,
     /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
     mass: SmallCholesky,
     /// The constraint rows projected on, the first `rows_h` holonomic (all rows unless
@@ -141,7 +146,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             vel: vec![0.0; m],
             mu: vec![0.0; m],
             lu_h: SmallCholesky::new(mh),
+            position_factor: false,
             lu_v: SmallCholesky::new(m),
+            dx: vec![0.0; n],
             mass: SmallCholesky::new(0),
             rows: (0..m).collect(),
             rows_h: mh,
@@ -224,6 +231,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             return false;
         }
         let rank = self.rows_h;
+        self.position_factor = false;
         let ok = self
             .kin
             .repartition(self.mech, &mut self.ws, t, &self.q)
@@ -424,9 +432,77 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// $\Delta q = -C_q^\mathsf{T}(C_q C_q^\mathsf{T})^{-1}C$ on the positions until
     /// $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$, then
     /// [`project_velocities`](Self::project_velocities).
+    ///
+    /// When the positions took a Newton update and every projected row is holonomic,
+    /// the velocities are projected by the chord iteration with the factor of the last
+    /// update's $J J^\mathsf{T}$ ([`chord_velocities`](Self::chord_velocities)), which
+    /// converges to the same orthogonal projection at the corrected positions: one
+    /// Gram matrix per projection.
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
         self.project_positions(t)?;
+        if self.position_factor && self.chord_velocities(t)? {
+            return Ok(());
+        }
         self.project_velocities(t)
+    }
+
+    /// Most updates of [`chord_velocities`](Self::chord_velocities).
+    const CHORD_UPDATES: usize = 4;
+
+    /// The orthogonal projection of [`project_velocities`](Self::project_velocities)
+    /// by the chord iteration
+    /// $\dot q \leftarrow \dot q - J^\mathsf{T}G_0^{-1}(J\dot q + [C_t; g])$, with $J$
+    /// at the current positions and $G_0$ the Gram matrix the last position update
+    /// factored (at positions off by that update, so the iteration contracts at a rate
+    /// proportional to its size, the positions' Newton tolerance times the
+    /// conditioning): every update lies in the range of $J^\mathsf{T}$, so the limit is
+    /// the orthogonal projection. Stops at round-off; returns `false` (velocities
+    /// unchanged or partly updated, for the factored projection to finish) when it
+    /// does not contract.
+    fn chord_velocities(&mut self, t: f64) -> Result<bool, SimErrorKind> {
+        let n = self.info.nq();
+        let eval = SimErrorKind::from_eval;
+        self.dense_jacobian(t).map_err(eval)?;
+        self.velocity_residuals(t).map_err(eval)?;
+        let m = self.rows.len();
+        let mut previous = f64::INFINITY;
+        for _ in 0..Self::CHORD_UPDATES {
+            for (mu, &i) in self.mu.iter_mut().zip(&self.rows) {
+                *mu = self.vel[i];
+            }
+            self.lu_h.solve(&mut self.mu[..m]);
+            let jac = self.ws.jacobian();
+            let dx = &mut self.dx;
+            dx.fill(0.0);
+            for (&i, mu) in self.rows.iter().zip(&self.mu) {
+                for (d, a) in dx.iter_mut().zip(&jac[i * n..(i + 1) * n]) {
+                    *d += a * mu;
+                }
+            }
+            let mut step = 0.0_f64;
+            for (v, d) in self.qd.iter_mut().zip(&*dx) {
+                *v -= d;
+                step = step.max(d.abs());
+            }
+            if !step.is_finite() || step >= 0.5 * previous {
+                return Ok(false);
+            }
+            previous = step;
+            // Met when every residual is at the round-off of its evaluation,
+            // 32 ε (Σⱼ |Jᵢⱼ q̇ⱼ| + |cᵢ|).
+            self.velocity_residuals(t).map_err(eval)?;
+            let jac = self.ws.jacobian();
+            let met = self.rows.iter().all(|&i| {
+                let row = &jac[i * n..(i + 1) * n];
+                let products: f64 = row.iter().zip(&self.qd).map(|(a, v)| (a * v).abs()).sum();
+                let c = self.vel[i] - row.iter().zip(&self.qd).map(|(a, v)| a * v).sum::<f64>();
+                self.vel[i].abs() <= 32.0 * f64::EPSILON * (products + c.abs())
+            });
+            if met {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// The positions' part of [`project`](Self::project).
@@ -436,6 +512,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let tol = self.newton.tolerance;
         // One renewal of the dropped redundant rows per projection (see `refit`).
         let mut refitted = false;
+        self.position_factor = false;
         if self.rows_h > 0 {
             let mut iterations = 0;
             let mut previous = f64::INFINITY;
@@ -492,6 +569,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 iterations += 1;
                 self.newton_iterations += 1;
                 self.factorizations += 1;
+                self.position_factor = self.rows.len() == self.rows_h;
             }
         }
         Ok(())
