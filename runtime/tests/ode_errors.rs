@@ -2,7 +2,7 @@
 //! readable: NaN from the right-hand side, the work limit, a finite-time blow-up, and a
 //! system error that the caller gets back with its own type.
 
-use pfaff::ode::samples::{BlowUp, Decay};
+use pfaff::ode::samples::{BlowUp, Decay, Kepler};
 use pfaff::ode::{
     Adams, Dop853, Dopri5, Integrator, OdeError, OdeOptions, OdeSystem, Quantity, RhsError, Rk4,
 };
@@ -241,4 +241,76 @@ fn bad_arguments_are_errors() {
         ode.set_state(&[f64::INFINITY]),
         Err(OdeError::NonFinite { .. })
     ));
+}
+
+/// Kepler's orbit ($e = 0.6$) whose evaluation number `fail_at` (counted from 1, the
+/// reset's included) fails once, not recoverably.
+struct FailsOnce {
+    evals: u64,
+    fail_at: u64,
+}
+
+impl OdeSystem for FailsOnce {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        self.evals += 1;
+        if self.evals == self.fail_at {
+            return Err(RhsError::new(Singular { pivot: 0 }));
+        }
+        Kepler { e: 0.6 }.rhs(t, y, dy)
+    }
+}
+
+/// An Adams step whose predictor or corrector evaluation fails leaves the integrator at
+/// its last accepted step: the same $(t, y)$, order and next step size, and a history
+/// (differences, step sizes, coefficients) from which the continuation ends where an
+/// uninterrupted run does (the Kepler orbit over one period, rtol = atol = 1e-10; the
+/// differences come back up to the rounding of undoing the predictor, so not bitwise).
+#[test]
+fn a_failed_adams_step_leaves_the_last_accepted_one() {
+    let tau = std::f64::consts::TAU;
+    let y0 = Kepler { e: 0.6 }.y0();
+    let opts = OdeOptions::with_tol(1e-10);
+    let mut sys = FailsOnce {
+        evals: 0,
+        fail_at: 0,
+    };
+    let mut reference = Adams::new(4, opts.clone()).unwrap();
+    reference.reset(&mut sys, 0.0, &y0, None).unwrap();
+    reference.integrate_to(&mut sys, tau).unwrap();
+    // After a reset every step evaluates at the prediction (even counts) and at the
+    // correction (odd counts); early (start phase, order rising) and late (order 10+).
+    let late = reference.stats().rhs_evals / 2 / 2 * 2;
+    assert!(
+        reference.order() >= 10 && late > 100,
+        "a long run at high order"
+    );
+    for fail_at in [8, 9, late, late + 1] {
+        let mut sys = FailsOnce { evals: 0, fail_at };
+        let mut ode = Adams::new(4, opts.clone()).unwrap();
+        ode.reset(&mut sys, 0.0, &y0, None).unwrap();
+        let (e, (t, y, order, h)) = loop {
+            assert!(
+                ode.t() < tau,
+                "{fail_at}: the failure is met before the end"
+            );
+            let last = (ode.t(), ode.y().to_vec(), ode.order(), ode.h_next());
+            if let Err(e) = ode.step(&mut sys, Some(tau)) {
+                break (e, last);
+            }
+        };
+        assert!(matches!(e, OdeError::Rhs { .. }), "{fail_at}: {e:?}");
+        assert_eq!((ode.t(), ode.y()), (t, &y[..]), "{fail_at}: state");
+        assert_eq!(
+            (ode.order(), ode.h_next()),
+            (order, h),
+            "{fail_at}: order, step"
+        );
+        ode.integrate_to(&mut sys, tau).unwrap();
+        for (a, b) in ode.y().iter().zip(reference.y()) {
+            assert!((a - b).abs() <= 1e-11, "{fail_at}: end {a} vs {b}");
+        }
+    }
 }
