@@ -29,6 +29,7 @@
 //!   holonomic and non-holonomic constraints ([`Impact`]), augmented and partitioned.
 //! - [`linearize()`]: the linearized reduced system and its eigenvalues.
 //! - [`PoseExt`]: frame poses and points as nalgebra types ([`nalgebra`] is re-exported).
+//! - [`math`]: the sine and cosine generated code calls (fdlibm's kernels, inlinable).
 //! - [`replay`]: the JSON trajectory format (times, poses, outputs, the drawing) for
 //!   viewers and other tools.
 //! - [`flex`]: deformable bodies from beam elements: inertia shape integrals and
@@ -52,6 +53,7 @@ mod joint_reactions;
 mod kinematics;
 mod linalg;
 mod linearize;
+pub mod math;
 mod mechanism;
 pub mod ode;
 mod partition;

@@ -77,9 +77,8 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
         }
     }
     for (k, &id) in prog.lets.iter().enumerate() {
-        let (ts, _) = printer.expr(id, true);
-        let name = names.temp(k);
-        let stmt = quote!(let #name = #ts;);
+        // A sine–cosine pair shares its argument's dependencies: both on one side.
+        let stmt = printer.define(k, id);
         if moving(id) {
             after.extend(stmt);
         } else {

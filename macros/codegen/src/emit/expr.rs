@@ -6,7 +6,7 @@ use quote::quote;
 
 use crate::sched::Program;
 use crate::sched::Run;
-use crate::sym::{ExprId, Graph, Node, Var};
+use crate::sym::{ExprId, Func, Graph, Node, Var};
 
 /// Binding strength of an emitted expression.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -111,6 +111,13 @@ impl Printer<'_> {
                 let (y, _) = self.expr(*y, false);
                 (quote!(#x.powf(#y)), Prec::Atom)
             }
+            // The runtime's sine and cosine (`pfaff::math`): inlined, without the C
+            // library's call and rounding-mode save.
+            Node::Call(f @ (Func::Sin | Func::Cos), x) => {
+                let (x, _) = self.expr(*x, false);
+                let m = Ident::new(f.name(), Span::call_site());
+                (quote!(::pfaff::math::#m(#x)), Prec::Atom)
+            }
             Node::Call(f, x) => {
                 let x = self.atom(*x);
                 let m = Ident::new(f.name(), Span::call_site());
@@ -122,6 +129,47 @@ impl Printer<'_> {
                 (quote!(#y.atan2(#x)), Prec::Atom)
             }
         }
+    }
+
+    /// The statement defining temporary `k`, node `id`: a `let` (or an element of
+    /// [`Printer::array`]). Of a [`Program::partner`] pair `sin u`, `cos u`, the first
+    /// defines both with one `sin_cos` call and the second nothing.
+    pub fn define(&self, k: usize, id: ExprId) -> TokenStream {
+        let place = |k: usize| match &self.array {
+            Some(array) => {
+                let k = Literal::usize_unsuffixed(k);
+                quote!(#array[#k])
+            }
+            None => {
+                let name = self.names.temp(k);
+                quote!(#name)
+            }
+        };
+        let let_ = if self.array.is_some() {
+            quote!()
+        } else {
+            quote!(let)
+        };
+        if let Some(&other) = self.prog.partner.get(&id) {
+            let j = self
+                .prog
+                .temp(other)
+                .expect("both of a pair are temporaries");
+            if j < k {
+                return TokenStream::new();
+            }
+            let (sin, cos, u) = match self.g.node(id) {
+                Node::Call(Func::Sin, u) => (k, j, *u),
+                Node::Call(Func::Cos, u) => (j, k, *u),
+                _ => unreachable!("pairs are a sine and a cosine"),
+            };
+            let (u, _) = self.expr(u, false);
+            let (sin, cos) = (place(sin), place(cos));
+            return quote!(#let_ (#sin, #cos) = ::pfaff::math::sin_cos(#u););
+        }
+        let (ts, _) = self.expr(id, true);
+        let place = place(k);
+        quote!(#let_ #place = #ts;)
     }
 
     /// An operand in receiver position (`x` in `x.sin()`).

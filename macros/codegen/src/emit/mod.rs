@@ -266,17 +266,9 @@ fn body(
     if let Some(array) = &array {
         let len = Literal::usize_unsuffixed(prog.lets.len());
         out.extend(quote!(let mut #array = [0.0_f64; #len];));
-        for (k, &id) in prog.lets.iter().enumerate() {
-            let (ts, _) = printer.expr(id, true);
-            let k = Literal::usize_unsuffixed(k);
-            out.extend(quote!(#array[#k] = #ts;));
-        }
-    } else {
-        for (k, &id) in prog.lets.iter().enumerate() {
-            let name = names.temp(k);
-            let (ts, _) = printer.expr(id, true);
-            out.extend(quote!(let #name = #ts;));
-        }
+    }
+    for (k, &id) in prog.lets.iter().enumerate() {
+        out.extend(printer.define(k, id));
     }
     for (k, &r) in roots.iter().enumerate() {
         let (ts, _) = printer.expr(r, false);

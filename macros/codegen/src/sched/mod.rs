@@ -14,13 +14,18 @@
 //! slices. The absorbed products are not scheduled, so neither they nor the data
 //! entries they read become statements: the code of a body of `n` modes grows like `n`
 //! per contraction instead of `n²` overall.
+//!
+//! **Sine–cosine pairs.** Where both `sin u` and `cos u` of one argument are live, both
+//! get a temporary (even when used once) and the pair is recorded in
+//! [`Program::partner`]: the emitter defines the two with one call of
+//! `::pfaff::math::sin_cos`, which reduces `u` once.
 
 mod runs;
 
 use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;
 
-use crate::sym::{ExprId, Graph, Node, Var};
+use crate::sym::{ExprId, Func, Graph, Node, Var};
 
 pub use runs::{Run, MIN_RUN};
 
@@ -39,6 +44,8 @@ pub struct Program {
     pub runs: HashMap<ExprId, (Vec<Run>, Vec<ExprId>)>,
     /// The first coordinate or velocity of each run (what the runs read of `q`, `q̇`).
     pub run_vars: BTreeSet<Var>,
+    /// For `sin u` its live `cos u` and the other way round: both are temporaries.
+    pub partner: HashMap<ExprId, ExprId>,
 }
 
 impl Program {
@@ -116,11 +123,12 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
     for r in roots {
         uses[r.index()] += 1;
     }
+    let partner = sin_cos_pairs(g, &order);
     let mut temp_of = vec![None; g.len()];
     let mut lets = Vec::new();
     for &id in &order {
         let leaf = matches!(g.node(id), Node::Const(_) | Node::Var(_));
-        if !leaf && uses[id.index()] >= 2 {
+        if !leaf && (uses[id.index()] >= 2 || partner.contains_key(&id)) {
             temp_of[id.index()] = Some(lets.len());
             lets.push(id);
         }
@@ -136,5 +144,26 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
         roots: roots.to_vec(),
         runs,
         run_vars,
+        partner,
     }
+}
+
+/// The live `sin u` and `cos u` of a common argument `u`, each mapped to the other.
+fn sin_cos_pairs(g: &Graph, order: &[ExprId]) -> HashMap<ExprId, ExprId> {
+    let mut sines = HashMap::new();
+    for &id in order {
+        if let Node::Call(Func::Sin, u) = g.node(id) {
+            sines.insert(*u, id);
+        }
+    }
+    let mut partner = HashMap::new();
+    for &id in order {
+        if let Node::Call(Func::Cos, u) = g.node(id) {
+            if let Some(&s) = sines.get(u) {
+                partner.insert(s, id);
+                partner.insert(id, s);
+            }
+        }
+    }
+    partner
 }
