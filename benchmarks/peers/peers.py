@@ -366,9 +366,28 @@ def fmt_ratio(x):
     return f"{x:.2g}" if x < 10 else f"{x:.0f}"
 
 
+def envelope(rows):
+    """For each pfaff run, the largest error of its method (model, formulation and
+    integrator) at its tolerance and every tighter one: the accuracy the run can be
+    counted on for. A final error is one sample of the error's oscillation along the
+    run, and a loose run can land near the reference by a lucky phase (andrews,
+    projection + DOP853: 4.1e-6 at rtol 3e-3 but 5.9e-4 at 1e-4); such a run must not
+    stand in for an accurate one."""
+    for r in rows:
+        if r["tool"].startswith("pfaff") and r["error"] is not None:
+            tighter = [
+                p["error"] for p in rows
+                if (p["model"], p["tool"]) == (r["model"], r["tool"]) and p["tol"] <= r["tol"]
+                and p["error"] is not None
+            ]  # fmt: skip
+            r["assured"] = max(tighter)
+
+
 def annotate(rows):
     """Adds the ratios to pfaff's default at the same tolerance and to the fastest pfaff
-    run (any method, any tolerance) that is at least as accurate."""
+    run (any method, any tolerance) that is at least as accurate (by the error it can be
+    counted on for, see `envelope`)."""
+    envelope(rows)
     for r in rows:
         ref = next((p for p in rows if p["model"] == r["model"] and p["tol"] == r["tol"] and p["tool"] == PFAFF_DEFAULT), None)
         ok = ref is not None and ref["error"] is not None and r["error"] is not None
@@ -379,7 +398,7 @@ def annotate(rows):
             candidates = [
                 p for p in rows
                 if p["model"] == r["model"] and p["tool"].startswith("pfaff") and p["error"] is not None
-                and p["error"] <= r["error"]
+                and p["assured"] <= r["error"]
             ]  # fmt: skip
             if candidates:
                 best = min(candidates, key=lambda p: p["wall"])
@@ -556,7 +575,9 @@ def main():
         "right-hand-side evaluations and wall time (best of several runs). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
         "with the fastest pfaff run, any method and tolerance (this table's and those of the half-decade "
-        "table below), that is at least as accurate.",
+        "table below), that is at least as accurate: whose error, and that of the same pfaff method at every "
+        "tighter tolerance, is at most the peer's (a loose run that meets the reference by a lucky phase "
+        "does not count).",
         *notes,
         render(rows),
         "## At equal accuracy",
