@@ -238,25 +238,22 @@ impl Lu {
         }
     }
 
-    /// Zeroes the matrix and writes its entries with `fill(set)`.
-    fn fill(&mut self, fill: impl FnOnce(&mut dyn FnMut(usize, usize, f64))) {
+    /// Zeroes the matrix.
+    fn zero(&mut self) {
+        match self {
+            Self::Small(lu) => lu.matrix_mut().fill(0.0),
+            Self::Dense(lu) => zero_dense(lu),
+        }
+    }
+
+    /// Sets entry `(i, j)`.
+    fn set(&mut self, i: usize, j: usize, v: f64) {
         match self {
             Self::Small(lu) => {
                 let n = lu.dim();
-                let a = lu.matrix_mut();
-                a.fill(0.0);
-                fill(&mut |i, j, v| a[i * n + j] = v);
+                lu.matrix_mut()[i * n + j] = v;
             }
-            Self::Dense(lu) => {
-                let n = lu.dim();
-                let mut a = lu.matrix_mut();
-                for j in 0..n {
-                    for i in 0..n {
-                        a[(i, j)] = 0.0;
-                    }
-                }
-                fill(&mut |i, j, v| a[(i, j)] = v);
-            }
+            Self::Dense(lu) => lu.matrix_mut()[(i, j)] = v,
         }
     }
 
@@ -618,9 +615,9 @@ impl Split {
     ) -> Result<f64, SplitFailure> {
         let n = info.nq();
         let r = self.rows_r.len();
-        let slot = &self.slot;
-        self.reduced
-            .fill(|set| augmented_entries(info, ws, Some(slot), set));
+        self.reduced.zero();
+        let reduced = &mut self.reduced;
+        augmented_entries(info, ws, Some(&self.slot), |i, j, v| reduced.set(i, j, v));
         let ratio = self.reduced.factor();
         if ratio.is_nan() || ratio <= rank_tolerance {
             return Err(SplitFailure::Singular(ratio));
@@ -657,13 +654,11 @@ impl Split {
         // Least-norm multipliers: T_D = J_D J_Rᵀ (J_R J_Rᵀ)⁻¹, λ = T (TᵀT)⁻¹ λ_R. With
         // X = S⁻¹ J_R J_Dᵀ (S = J_R J_Rᵀ symmetric), T_D = Xᵀ and TᵀT = I + X Xᵀ.
         let rows_r = &self.rows_r;
-        self.gram.fill(|set| {
-            for (a, &ra) in rows_r.iter().enumerate() {
-                for (c, &rc) in rows_r.iter().enumerate() {
-                    set(a, c, dot(row(ra), row(rc)));
-                }
+        for (a, &ra) in rows_r.iter().enumerate() {
+            for (c, &rc) in rows_r.iter().enumerate() {
+                self.gram.set(a, c, dot(row(ra), row(rc)));
             }
-        });
+        }
         self.gram.factor();
         for (column, &d) in self.xt.chunks_exact_mut(r.max(1)).zip(&self.rows_d) {
             for (v, &ra) in column.iter_mut().zip(rows_r) {
@@ -672,14 +667,12 @@ impl Split {
             self.gram.solve(column);
         }
         let xt = &self.xt;
-        self.gram.fill(|set| {
-            for a in 0..r {
-                for c in 0..r {
-                    let xx: f64 = xt.chunks_exact(r).map(|col| col[a] * col[c]).sum();
-                    set(a, c, f64::from(u8::from(a == c)) + xx);
-                }
+        for a in 0..r {
+            for c in 0..r {
+                let xx: f64 = xt.chunks_exact(r).map(|col| col[a] * col[c]).sum();
+                self.gram.set(a, c, f64::from(u8::from(a == c)) + xx);
             }
-        });
+        }
         self.gram.factor();
         self.y.copy_from_slice(&x[n..]);
         self.gram.solve(&mut self.y);
@@ -779,6 +772,13 @@ fn augmented_entries(
 /// Writes the augmented matrix with the rows of $J$ that `slot` places into `lu` (see
 /// [`augmented_entries`]).
 fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, slot: Option<&[usize]>) {
+    zero_dense(lu);
+    let mut a = lu.matrix_mut();
+    augmented_entries(info, ws, slot, |i, j, v| a[(i, j)] = v);
+}
+
+/// Zeroes the matrix of `lu`.
+fn zero_dense(lu: &mut DenseLu) {
     let dim = lu.dim();
     let mut a = lu.matrix_mut();
     for j in 0..dim {
@@ -786,7 +786,6 @@ fn fill_dense(lu: &mut DenseLu, info: &Info, ws: &Workspace, slot: Option<&[usiz
             a[(i, j)] = 0.0;
         }
     }
-    augmented_entries(info, ws, slot, |i, j, v| a[(i, j)] = v);
 }
 
 /// Writes the augmented matrix into the row-major `lu`.

@@ -327,6 +327,21 @@ impl Workspace {
     /// The model passed has the description this workspace was made for (same
     /// `Info`, or one with the same name and shapes), so that its functions write
     /// buffers of the sizes reserved here; `q` (and `qd`) have its length.
+    /// The output slices of the fused evaluation, and the rates $C_t$, $g$ beside them
+    /// (read by the correction of [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected)).
+    fn dynamics_outputs(&mut self) -> (crate::DynamicsTerms<'_>, (&[f64], &[f64])) {
+        let (gamma_h, gamma_nh) = self.gamma.split_at_mut(self.info.nh());
+        let terms = crate::DynamicsTerms {
+            mass: &mut self.mass_values,
+            forces: &mut self.forces,
+            holonomic_jacobian: &mut self.cq_values,
+            holonomic_gamma: gamma_h,
+            nonholonomic_matrix: &mut self.g_values,
+            nonholonomic_gamma: gamma_nh,
+        };
+        (terms, (&self.ct, &self.bias))
+    }
+
     fn check_model<M: Mechanism + ?Sized>(
         &self,
         mech: &M,
@@ -494,22 +509,8 @@ impl Workspace {
         qd: &[f64],
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let info = self.info;
-        let mh = info.nh();
-        let (gamma_h, gamma_nh) = self.gamma.split_at_mut(mh);
-        mech.dynamics_terms(
-            t,
-            q,
-            qd,
-            crate::DynamicsTerms {
-                mass: &mut self.mass_values,
-                forces: &mut self.forces,
-                holonomic_jacobian: &mut self.cq_values,
-                holonomic_gamma: gamma_h,
-                nonholonomic_matrix: &mut self.g_values,
-                nonholonomic_gamma: gamma_nh,
-            },
-        );
+        let (terms, _) = self.dynamics_outputs();
+        mech.dynamics_terms(t, q, qd, terms);
         self.check_dynamics_terms(t)
     }
 
@@ -528,23 +529,10 @@ impl Workspace {
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let mh = self.info.nh();
-        let (gamma_h, gamma_nh) = self.gamma.split_at_mut(mh);
-        let (ct, bias) = (&self.ct, &self.bias);
-        mech.dynamics_terms_corrected(
-            t,
-            q,
-            qd,
-            crate::DynamicsTerms {
-                mass: &mut self.mass_values,
-                forces: &mut self.forces,
-                holonomic_jacobian: &mut self.cq_values,
-                holonomic_gamma: gamma_h,
-                nonholonomic_matrix: &mut self.g_values,
-                nonholonomic_gamma: gamma_nh,
-            },
-            &mut |cq, g, qd| correct(cq, g, ct, bias, qd),
-        );
+        let (terms, (ct, bias)) = self.dynamics_outputs();
+        mech.dynamics_terms_corrected(t, q, qd, terms, &mut |cq, g, qd| {
+            correct(cq, g, ct, bias, qd);
+        });
         self.check_dynamics_terms(t)
     }
 
