@@ -51,6 +51,7 @@ impl Stamp {
 
     /// Whether the group holds values at `(t, q, qd)` (`qd` ignored for position-only
     /// groups).
+    #[inline]
     fn matches(&self, t: f64, q: &[f64], qd: &[f64]) -> bool {
         self.valid
             && self.t.to_bits() == t.to_bits()
@@ -59,6 +60,7 @@ impl Stamp {
     }
 
     /// Records that the group now holds values at `(t, q, qd)`.
+    #[inline]
     fn set(&mut self, t: f64, q: &[f64], qd: &[f64]) {
         self.valid = true;
         self.t = t;
@@ -70,6 +72,7 @@ impl Stamp {
 
     /// [`matches`](Self::matches); otherwise invalidates the stamp, for the caller to
     /// evaluate and [`set`](Self::set) it.
+    #[inline]
     fn check(&mut self, t: f64, q: &[f64], qd: &[f64]) -> bool {
         let same = self.matches(t, q, qd);
         self.valid &= same;
@@ -753,10 +756,7 @@ mod tests {
 
     static INFO: Info = Info {
         name: "circle",
-        coordinates: &[
-            Symbol { name: "x", doc: "" },
-            Symbol { name: "y", doc: "" },
-        ],
+        coordinates: &[Symbol { name: "x", doc: "" }, Symbol { name: "y", doc: "" }],
         holonomic: &[Symbol {
             name: "radius",
             doc: "",
@@ -807,8 +807,12 @@ mod tests {
     #[test]
     fn constraints_come_with_the_jacobian_when_both_were_read() {
         let mech = Circle;
-        let mut p = Point::new(&mech, DynamicsParams::default(), KinematicsParams::default())
-            .expect("a point");
+        let mut p = Point::new(
+            &mech,
+            DynamicsParams::default(),
+            KinematicsParams::default(),
+        )
+        .expect("a point");
         // Reading C only, at three iterates.
         p.set_state(&[1.2, 0.1, 0.0, 0.0]);
         for k in 0..3 {

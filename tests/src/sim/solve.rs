@@ -381,7 +381,10 @@ fn constraints_with_jacobian_equal_the_separate_functions() {
         }
         let name = entry.name;
         let pattern = info.holonomic_pattern;
-        for (j, (q, _)) in states(model.as_ref(), 5, 40 + k as u64).into_iter().enumerate() {
+        for (j, (q, _)) in states(model.as_ref(), 5, 40 + k as u64)
+            .into_iter()
+            .enumerate()
+        {
             #[allow(clippy::cast_precision_loss)]
             let t = 0.1 * j as f64;
             let (mut c, mut cq) = (vec![f64::NAN; mh], vec![f64::NAN; pattern.len()]);
@@ -427,6 +430,12 @@ fn constraints_with_jacobian_equal_the_separate_functions() {
         }
         checked += 1;
     }
-    assert!(checked >= 10, "only {checked} models with holonomic constraints");
-    eprintln!("{checked} models, {bitwise} of {} states equal to the bit", 5 * checked);
+    assert!(
+        checked >= 10,
+        "only {checked} models with holonomic constraints"
+    );
+    eprintln!(
+        "{checked} models, {bitwise} of {} states equal to the bit",
+        5 * checked
+    );
 }
