@@ -288,8 +288,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// held at the point and was asked for after $C$ at the last point $C$ was
     /// evaluated at: an iteration that reads both at each iterate (the chart's polish)
     /// gets both from one call from its second iterate on, one that reads only $C$
-    /// (the chart's correction) pays for $C_q$'s products once and then evaluates $C$
-    /// alone. Callers that know they need both call
+    /// from a state just set (the chart's correction, after
+    /// [`set_state`](Self::set_state)) evaluates $C$ alone. Callers that know they need
+    /// both call
     /// [`constraints_with_jacobian`](Self::constraints_with_jacobian).
     pub fn constraints(&mut self, t: f64) -> Result<&[f64], EvalError> {
         if !self.constraints.check(t, &self.q, &[]) {
