@@ -307,6 +307,49 @@ impl SmallCholesky {
         }
     }
 
+    /// Solves $A X = B$ in place for the `k` columns of `x` (`n × k`, row-major) with
+    /// the last factorization: the substitutions run along the rows of `x`, so the
+    /// columns are solved side by side.
+    pub fn solve_rows(&self, x: &mut [f64], k: usize) {
+        let n = self.n;
+        let (a, scale, inverse) = (&self.a, &self.scale, &self.inverse);
+        if fixed!(n, solve_rows_fixed(a, scale, inverse, x, k)).is_some() {
+            return;
+        }
+        let a = &self.a[..n * n];
+        let x = &mut x[..n * k];
+        let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
+        if k == 0 {
+            return;
+        }
+        for (row, s) in x.chunks_exact_mut(k).zip(scale) {
+            row.iter_mut().for_each(|v| *v *= s);
+        }
+        for j in 0..n {
+            let (head, tail) = x.split_at_mut((j + 1) * k);
+            let xj = &mut head[j * k..];
+            xj.iter_mut().for_each(|v| *v *= inverse[j]);
+            for (row, u) in tail.chunks_exact_mut(k).zip(&a[j * n + j + 1..(j + 1) * n]) {
+                for (v, w) in row.iter_mut().zip(&*xj) {
+                    *v -= u * w;
+                }
+            }
+        }
+        for i in (0..n).rev() {
+            let (head, tail) = x.split_at_mut(i * k);
+            let xi = &mut tail[..k];
+            xi.iter_mut().for_each(|v| *v *= inverse[i]);
+            for (row, l) in head.chunks_exact_mut(k).zip(&a[i * n..i * n + i]) {
+                for (v, w) in row.iter_mut().zip(&*xi) {
+                    *v -= l * w;
+                }
+            }
+        }
+        for (row, s) in x.chunks_exact_mut(k).zip(scale) {
+            row.iter_mut().for_each(|v| *v *= s);
+        }
+    }
+
     /// Writes $A^{-1}$ (row-major `n × n`, both triangles) into `out` from the last
     /// factorization, as LAPACK's `potri` forms it: $W = L^{-1}$ by rows, then
     /// $A^{-1} = D W^\mathsf{T} W D$ ($D$ the equilibration). Every entry of both
@@ -454,6 +497,30 @@ fn solve_fixed<const N: usize>(a: &[f64], scale: &[f64], inverse: &[f64], b: &mu
     substitute_fixed(a, inverse, &mut x);
     for i in 0..N {
         b[i] = x[i] * scale[i];
+    }
+}
+
+/// [`SmallCholesky::solve_rows`] for `N × N`: column by column, each one unrolled
+/// (the columns' chains are independent, so consecutive ones overlap).
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn solve_rows_fixed<const N: usize>(
+    a: &[f64],
+    scale: &[f64],
+    inverse: &[f64],
+    x: &mut [f64],
+    k: usize,
+) {
+    let (x, scale) = (&mut x[..N * k], &scale[..N]);
+    for c in 0..k {
+        let mut col = [0.0_f64; N];
+        for i in 0..N {
+            col[i] = x[i * k + c] * scale[i];
+        }
+        substitute_fixed(a, inverse, &mut col);
+        for i in 0..N {
+            x[i * k + c] = col[i] * scale[i];
+        }
     }
 }
 
@@ -610,6 +677,20 @@ mod tests {
                 ];
                 let mut inv = vec![0.0; n * n];
                 ch.inverse_into(&mut inv);
+                // The columns side by side: the identity's give the inverse.
+                let mut e: Vec<f64> = (0..n * n)
+                    .map(|k| if k / n == k % n { 1.0 } else { 0.0 })
+                    .collect();
+                ch.solve_rows(&mut e, n);
+                for i in 0..n {
+                    for k in 0..n {
+                        let size = (inv[i * n + i] * inv[k * n + k]).sqrt();
+                        #[allow(clippy::cast_precision_loss)]
+                        let tol = 1e3 * f64::EPSILON * size * (n * n) as f64;
+                        let err = (e[i * n + k] - inv[i * n + k]).abs();
+                        assert!(err <= tol, "solve_rows n = {n} spread {spread}: {err:e}");
+                    }
+                }
                 for b in &cols {
                     // The explicit inverse times b against the solve.
                     let z: Vec<f64> = (0..n)

@@ -13,9 +13,8 @@
 //! **Newton.** The iteration starts from the integrator's own prediction (off the
 //! manifold by the local error) and is a chord iteration with the map
 //! $P = N^\mathsf{T}(N N^\mathsf{T})^{-1}$ of the anchor ($\Delta q = -P\,C_R$), so an
-//! evaluation factors and solves nothing: the anchor keeps $(N N^\mathsf{T})^{-1}$
-//! explicitly, and one update is a product with that `r × r` matrix and one with
-//! $N^\mathsf{T}$. It converges
+//! evaluation factors and solves nothing: one update is one product with an
+//! `n × r` matrix. It converges
 //! linearly with a rate proportional to the distance from the anchor; the rate per unit
 //! distance is measured whenever two updates are taken and carried to the next
 //! evaluations. The iteration stops when the estimated remaining error
@@ -85,9 +84,6 @@ impl From<EvalError> for ChartFailure {
     }
 }
 
-/// The residuals, scratch of length `r` and of length `n` of a position update.
-type Vectors<'a> = (&'a [f64], &'a mut [f64], &'a mut [f64]);
-
 /// The maps of one anchor: where they were made, its Jacobian and the explicit
 /// inverses of its Gram matrices (formed from the Cholesky factor as
 /// $D L^{-\mathsf{T}} L^{-1} D$, see [`SmallCholesky::inverse_into`]).
@@ -97,9 +93,8 @@ struct Maps {
     anchor: Vec<f64>,
     /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows[..rows_h]`.
     normals: Vec<f64>,
-    /// $(N N^\mathsf{T})^{-1}$, row-major `r × r`, when there are non-holonomic rows
-    /// (otherwise it is `velocity_map`, see [`position_inverse`](Self::position_inverse)).
-    position_inverse: Vec<f64>,
+    /// $(N N^\mathsf{T})^{-1}N$, row-major `r × n` (its transpose is the map $P$).
+    position_map: Vec<f64>,
     /// $G_a^{-1} = (J_a J_a^\mathsf{T})^{-1}$ of every projected row (holonomic and
     /// non-holonomic), row-major `m × m`, and whether $G_a$ is regular.
     velocity_map: Vec<f64>,
@@ -121,7 +116,7 @@ impl Maps {
         Self {
             anchor: vec![0.0; n],
             normals: vec![0.0; m * n],
-            position_inverse: vec![0.0; if m > r { r * r } else { 0 }],
+            position_map: vec![0.0; n * r],
             velocity_map: vec![0.0; m * m],
             velocity_map_regular: false,
             slot: vec![usize::MAX; m],
@@ -146,10 +141,9 @@ impl Maps {
         self.rows.extend_from_slice(&p.rows);
         self.rows_h = p.rows_h;
         let (n, r, m) = (p.q.len(), p.rows_h, p.rows.len());
-        let position_len = if m > r { r * r } else { 0 };
-        if self.position_inverse.len() != position_len || self.velocity_map.len() != m * m {
+        if self.position_map.len() != n * r || self.velocity_map.len() != m * m {
             // Assembly dropped redundant rows (allocates, once).
-            self.position_inverse = vec![0.0; position_len];
+            self.position_map = vec![0.0; n * r];
             self.velocity_map = vec![0.0; m * m];
         }
         self.slot.fill(usize::MAX);
@@ -166,37 +160,21 @@ impl Maps {
         }
         gram.resize(r);
         let ratio = gram_cholesky(gram, &self.normals, &self.rows[..r], n);
+        for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
+            out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
+        }
+        gram.solve_rows(&mut self.position_map, n);
         if m == r {
             gram.inverse_into(&mut self.velocity_map);
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
-        } else {
-            gram.inverse_into(&mut self.position_inverse);
         }
         self.ratio = ratio;
         Ok(ratio)
     }
 
-    /// $(N N^\mathsf{T})^{-1}$, row-major `r × r`: $G_a^{-1}$ itself when every row is
-    /// holonomic.
-    fn position_inverse(&self) -> &[f64] {
-        if self.rows.len() == self.rows_h {
-            &self.velocity_map
-        } else {
-            &self.position_inverse
-        }
-    }
-
     /// A position update with these maps (see [`update`]).
-    fn update(&self, (mu, y, dx): Vectors<'_>, x: &mut [f64], tol: (f64, f64)) -> (f64, f64) {
-        let r = self.rows_h;
-        update(
-            self.position_inverse(),
-            &self.normals,
-            &self.rows[..r],
-            (&mu[..r], &mut y[..r], dx),
-            x,
-            tol,
-        )
+    fn update(&self, mu: &[f64], dx: &mut [f64], x: &mut [f64], tol: (f64, f64)) -> (f64, f64) {
+        update(&self.position_map, &mu[..self.rows_h], x, dx, tol)
     }
 
     /// Whether the velocity iteration with these maps serves the rows of `p` (see
@@ -229,10 +207,10 @@ pub(crate) struct Chart {
     /// made for (`None`: no staged maps).
     staged_for: Option<f64>,
     staged_q: Vec<f64>,
-    /// The factorization of a Gram matrix, scratch for the maps.
-    gram: SmallCholesky,
     /// $G_a^{-1}$ times the velocity residuals.
     nu: Vec<f64>,
+    /// The factorization of a Gram matrix, scratch for the maps.
+    gram: SmallCholesky,
     /// The velocity residuals of every constraint row.
     vel: Vec<f64>,
     /// The residuals of the current update.
@@ -275,29 +253,22 @@ fn symmetric_product(a: &[f64], x: &[f64], y: &mut [f64]) {
     }
 }
 
-/// $x \leftarrow x - N_R^\mathsf{T}(N_R N_R^\mathsf{T})^{-1}\mu$ for the rows `rows` of the
-/// dense row-major `normals` (`· × n`) and `inverse` $= (N_R N_R^\mathsf{T})^{-1}$
-/// (`|R| × |R|`), with `y` (length `|R|`) and `dx` (length `n`) as scratch; returns the largest change and
-/// the largest in the weights $\text{atol} + \text{rtol}\,|x_j|$ (at the new values),
-/// NaN when a change is NaN.
+/// $x \leftarrow x - M^\mathsf{T}\mu$ for the map `map` (`|μ| × n`, row-major), with
+/// `dx` (length `n`) as scratch; returns the largest change and the largest in the
+/// weights $\text{atol} + \text{rtol}\,|x_j|$ (at the new values), NaN when a change is
+/// NaN.
 fn update(
-    inverse: &[f64],
-    normals: &[f64],
-    rows: &[usize],
-    (mu, y, dx): (&[f64], &mut [f64], &mut [f64]),
+    map: &[f64],
+    mu: &[f64],
     x: &mut [f64],
+    dx: &mut [f64],
     (rtol, atol): (f64, f64),
 ) -> (f64, f64) {
-    let (n, r) = (x.len(), rows.len());
-    if r == 0 {
-        return (0.0, 0.0);
-    }
-    symmetric_product(inverse, mu, y);
-    // Δx = Σ_i y_i N_i, a contiguous row at a time.
+    let n = x.len();
     dx.fill(0.0);
-    for (&i, &yi) in rows.iter().zip(&*y) {
-        for (d, a) in dx.iter_mut().zip(&normals[i * n..(i + 1) * n]) {
-            *d += a * yi;
+    for (row, m) in map.chunks_exact(n.max(1)).zip(mu) {
+        for (d, a) in dx.iter_mut().zip(row) {
+            *d += a * m;
         }
     }
     let (mut step, mut weighted, mut nan) = (0.0_f64, 0.0_f64, false);
@@ -433,9 +404,8 @@ impl Chart {
             for (mu, &i) in self.mu.iter_mut().zip(&self.staged.rows[..r]) {
                 *mu = c[i];
             }
-            let scratch = (&self.mu[..], &mut self.nu[..], &mut self.dx[..]);
-            self.staged
-                .update(scratch, &mut p.q, (self.rtol, self.atol));
+            let tol = (self.rtol, self.atol);
+            self.staged.update(&self.mu, &mut self.dx, &mut p.q, tol);
             p.newton_iterations += 1;
         }
         Ok(None)
@@ -479,8 +449,8 @@ impl Chart {
                     residual,
                 });
             }
-            let scratch = (&self.mu[..], &mut self.nu[..], &mut self.dx[..]);
-            let (step, weighted) = self.maps.update(scratch, &mut p.q, (self.rtol, self.atol));
+            let tol = (self.rtol, self.atol);
+            let (step, weighted) = self.maps.update(&self.mu, &mut self.dx, &mut p.q, tol);
             // An update at round-off has converged, whatever rate its noise suggests.
             if step <= floor {
                 return Ok(iteration + 1);
