@@ -505,14 +505,16 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         // point of the chart the integrator has just evaluated, polished; the
         // right-hand side is invariant to the move, so the integrator keeps its
         // derivatives), then the anchor of the next step.
-        rec.y.copy_from_slice(stepper.y());
-        let mut correction = check!(rec.sys.keep(t, rec.y));
+        // The state is read from the integrator and, when corrected, written back.
+        let mut correction = check!(rec.sys.keep(t, stepper.y()));
         if let Some(c) = rec.sys.contacts.as_mut() {
             if check!(c.project(&mut rec.sys.point, t)) {
                 correction = Correction::Changed;
             }
         }
-        rec.sys.gather(rec.y);
+        if correction != Correction::None {
+            rec.sys.gather(rec.y);
+        }
         match correction {
             Correction::None => {}
             Correction::SameDerivative => {
