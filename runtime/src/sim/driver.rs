@@ -370,6 +370,13 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         return Err(rec.fail(Some(&stepper), kind));
     }
 
+    // Projection with an explicit pair: the next step starts from the projected state
+    // with the FSAL derivative of the unprojected one, as Adams keeps its differences
+    // (ARCHITECTURE.md, "the FSAL derivative survives the projection"): the
+    // projection moves the state by about the local error, so the derivative's error
+    // enters the next step multiplied by h, below the local error of the method.
+    let keeps_fsal = sim.formulation == Formulation::Projection
+        && matches!(sim.method, Method::Dopri5 | Method::Dop853);
     let mut yout = vec![0.0; dim];
     // A closing located on a dense output coarser than the steps is moved to where the
     // steps put it (`contacts::refine`), which needs the state at the start of the step.
@@ -507,6 +514,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         // derivatives), then the anchor of the next step.
         // The state is read from the integrator and, when corrected, written back.
         let mut correction = check!(rec.sys.keep(t, stepper.y()));
+        if keeps_fsal && correction == Correction::Changed {
+            correction = Correction::SameDerivative;
+        }
         if let Some(c) = rec.sys.contacts.as_mut() {
             if check!(c.project(&mut rec.sys.point, t)) {
                 correction = Correction::Changed;
