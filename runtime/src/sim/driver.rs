@@ -343,12 +343,17 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             SimErrorKind::Integrator(OdeError::InvalidStepSize { h }),
         ));
     }
+    // Dense output only where the run interpolates: rows on a grid or at given times,
+    // and the location of contact events. DOP853 pays three evaluations per step for
+    // it (the other methods have it free); a run with rows at the steps or at the end
+    // only lands on them.
+    let interpolates = !times.is_empty() || rec.sys.contacts.is_some();
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
         h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
         h_max,
         max_steps: sim.max_steps,
-        dense_output: true,
+        dense_output: interpolates,
     };
     let mut stepper = match Stepper::new(sim.method, dim, opts) {
         Ok(s) => s,
