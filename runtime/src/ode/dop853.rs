@@ -37,6 +37,9 @@ pub struct Dop853(RkDriver<Dp853>);
 pub(crate) struct Dp853 {
     /// Whether `cont` describes the last step.
     dense_ready: bool,
+    /// With `dense_output`, the interpolant is prepared only on the steps that reach
+    /// this time (every step when `None`), see [`Dop853::dense_output_from`].
+    dense_from: Option<f64>,
     /// Stage derivatives 1–16 (index = stage − 1).
     k: [Vec<f64>; 16],
     /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f).
@@ -96,6 +99,7 @@ impl Dop853 {
         let ctrl = PiController::new(1.0 / 8.0, 0.0, 0.9, 0.333, 6.0);
         let m = Dp853 {
             dense_ready: false,
+            dense_from: None,
             k: std::array::from_fn(|_| v()),
             cont: std::array::from_fn(|_| v()),
         };
@@ -105,6 +109,15 @@ impl Dop853 {
     /// The options in use.
     pub fn options(&self) -> &OdeOptions {
         &self.0.st.opts
+    }
+
+    /// With `dense_output` on, prepares the interpolant (three evaluations) only on the
+    /// accepted steps that reach `t` in the direction of integration; `None` (the
+    /// default): on every step. A caller that interpolates at known times sets the
+    /// next of them before each step; [`interpolate`](Integrator::interpolate) on a
+    /// step without the interpolant fails with [`OdeError::DenseOutputUnavailable`].
+    pub fn dense_output_from(&mut self, t: Option<f64>) {
+        self.0.method_mut().dense_from = t;
     }
 }
 
@@ -228,8 +241,9 @@ impl EmbeddedRk for Dp853 {
         Ok(h.abs() * e5 * (1.0 / (st.y.len() as f64 * deno)).sqrt())
     }
 
-    /// The FSAL stage $f(t_{\text{new}}, y_{n+1})$ and, with `dense_output`, the dense
-    /// stages and the interpolant.
+    /// The FSAL stage $f(t_{\text{new}}, y_{n+1})$ and, with `dense_output` (on a step
+    /// that reaches [`dense_from`](Self::dense_from)), the dense stages and the
+    /// interpolant.
     fn accept<S: OdeSystem + ?Sized>(
         &mut self,
         st: &mut RkState,
@@ -239,7 +253,8 @@ impl EmbeddedRk for Dp853 {
     ) -> Result<(), OdeError> {
         let mut fsal = eval(sys, &mut st.stats, t_new, &st.y_new, &mut self.k[FSAL]);
         self.dense_ready = false;
-        if fsal.is_ok() && st.opts.dense_output {
+        let wanted = self.dense_from.is_none_or(|td| (t_new - td) * h >= 0.0);
+        if fsal.is_ok() && st.opts.dense_output && wanted {
             fsal = self.store_dense(st, sys, h);
             self.dense_ready = fsal.is_ok();
         }

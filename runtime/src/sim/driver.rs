@@ -348,6 +348,10 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     // it (the other methods have it free); a run with rows at the steps or at the end
     // only lands on them.
     let interpolates = !times.is_empty() || rec.sys.contacts.is_some();
+    // Without contacts only the rows interpolate: DOP853 then prepares its interpolant
+    // on the steps that reach the next row, not on the steps between rows of a grid
+    // coarser than the steps.
+    let rows_only = rec.sys.contacts.is_none();
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
         h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
@@ -413,6 +417,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             y_start.copy_from_slice(stepper.y());
         }
         let partitions = rec.sys.point.kin.repartitions();
+        if rows_only {
+            // The interpolant on the steps that reach the next row only.
+            let next = times.get(next_out).copied().unwrap_or(f64::INFINITY);
+            stepper.dense_output_from(Some(next));
+        }
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {

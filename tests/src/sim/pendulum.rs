@@ -278,3 +278,39 @@ fn dop853_pays_for_dense_output_only_when_rows_interpolate() {
         assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{x} {y}");
     }
 }
+
+/// On a grid coarser than the steps, DOP853 prepares its interpolant only on the
+/// steps that reach a row: three evaluations per row at most, not per step; the rows
+/// follow the exact solution (benchmark-models.md) as the steps do.
+#[test]
+fn dop853_interpolates_only_on_steps_that_reach_a_row() {
+    let model = pendulum::Model::default();
+    let run = |sim: Simulation<'_, _>| {
+        sim.formulation(Formulation::Projection)
+            .integrator(Method::Dop853)
+            .tolerances(1e-9, 1e-9)
+            .run(30.0)
+            .unwrap()
+    };
+    let end = run(Simulation::new(&model).output_times(&[]));
+    let grid = run(Simulation::new(&model).output_every(3.0));
+    let (s, g) = (&end.stats, &grid.stats);
+    eprintln!(
+        "steps {} evaluations {} -> {}, error {:.1e}",
+        s.steps,
+        s.rhs_evals,
+        g.rhs_evals,
+        max_error(&grid)
+    );
+    assert_eq!((g.steps, g.rejected), (s.steps, s.rejected));
+    assert!(s.steps > 100, "{s:?}");
+    let dense = (g.rhs_evals - s.rhs_evals) / 3;
+    assert_eq!(g.rhs_evals, s.rhs_evals + 3 * dense);
+    assert!(
+        (1..=10).contains(&dense),
+        "{dense} steps with the interpolant"
+    );
+    assert_eq!(grid.trajectory.len(), 11);
+    // Integrated results: solver tolerance × 1e3 over ten periods.
+    assert!(max_error(&grid) < 1e3 * 1e-9);
+}
