@@ -180,6 +180,8 @@ pub(crate) struct SmallCholesky {
     scale: Vec<f64>,
     /// $1 / l_{kk}$.
     inverse: Vec<f64>,
+    /// Scratch of [`inverse_into`](Self::inverse_into) beyond [`FIXED`].
+    work: Vec<f64>,
 }
 
 impl SmallCholesky {
@@ -189,6 +191,11 @@ impl SmallCholesky {
             a: vec![0.0; n * n],
             scale: vec![1.0; n],
             inverse: vec![1.0; n],
+            work: if n > FIXED {
+                vec![0.0; n * n]
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -342,6 +349,70 @@ impl SmallCholesky {
             row.iter_mut().for_each(|v| *v *= s);
         }
     }
+
+    /// Writes $A^{-1}$ (row-major `n × n`, both triangles) into `out` from the last
+    /// factorization, as LAPACK's `potri` forms it: $W = L^{-1}$ by rows, then
+    /// $A^{-1} = D W^\mathsf{T} W D$ ($D$ the equilibration). Every entry of both
+    /// products is an independent dot product, so the work is $n^3/3$ multiply-adds
+    /// without the dependent chains of `n` solves with the columns of the identity.
+    pub fn inverse_into(&mut self, out: &mut [f64]) {
+        let n = self.n;
+        let (a, scale, inverse) = (&self.a, &self.scale, &self.inverse);
+        if fixed!(n, inverse_fixed(a, scale, inverse, out)).is_some() {
+            return;
+        }
+        let a = &self.a[..n * n];
+        let (scale, inverse) = (&self.scale[..n], &self.inverse[..n]);
+        let w = &mut self.work[..n * n];
+        let out = &mut out[..n * n];
+        // Row i of W from the rows above it: (L W)_{ik} = 0 for k < i.
+        for i in 0..n {
+            let (done, rest) = w.split_at_mut(i * n);
+            let li = &a[i * n..i * n + i];
+            for k in 0..i {
+                let s: f64 = (k..i).map(|j| li[j] * done[j * n + k]).sum();
+                rest[k] = -s * inverse[i];
+            }
+            rest[i] = inverse[i];
+        }
+        for i in 0..n {
+            for k in 0..=i {
+                let s: f64 = (i..n).map(|j| w[j * n + i] * w[j * n + k]).sum();
+                let v = s * (scale[i] * scale[k]);
+                out[i * n + k] = v;
+                out[k * n + i] = v;
+            }
+        }
+    }
+}
+
+/// [`SmallCholesky::inverse_into`] for `N × N`.
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn inverse_fixed<const N: usize>(a: &[f64], scale: &[f64], inverse: &[f64], out: &mut [f64]) {
+    let (a, scale, inverse, out) = (&a[..N * N], &scale[..N], &inverse[..N], &mut out[..N * N]);
+    let mut w = [[0.0_f64; N]; N];
+    for i in 0..N {
+        for k in 0..i {
+            let mut s = 0.0;
+            for j in k..i {
+                s += a[i * N + j] * w[j][k];
+            }
+            w[i][k] = -s * inverse[i];
+        }
+        w[i][i] = inverse[i];
+    }
+    for i in 0..N {
+        for k in 0..=i {
+            let mut s = 0.0;
+            for j in i..N {
+                s += w[j][i] * w[j][k];
+            }
+            let v = s * (scale[i] * scale[k]);
+            out[i * N + k] = v;
+            out[k * N + i] = v;
+        }
+    }
 }
 
 /// [`SmallCholesky::factor`] for `N × N` (same operations, in a local array).
@@ -455,17 +526,52 @@ fn solve_rows_fixed<const N: usize>(
 
 /// Writes $A_R A_R^\mathsf{T}$ of the rows `rows` of the dense row-major `a` (`· × n`)
 /// into `ch`, factors it and returns the pivot ratio (0 when not positive definite).
+///
+/// Up to [`FIXED`] rows the lower triangle is accumulated in registers, one column of
+/// $A_R$ at a time (a sum of outer products): its `r(r+1)/2` sums are independent, where
+/// dot products of rows are each a chain of `n` dependent additions. The sums run over
+/// the columns in the same order either way, so the two give the same bits.
 pub(crate) fn gram_cholesky(ch: &mut SmallCholesky, a: &[f64], rows: &[usize], n: usize) -> f64 {
     let r = rows.len();
     let g = ch.matrix_mut();
-    for (i, &ri) in rows.iter().enumerate() {
-        let ri = &a[ri * n..(ri + 1) * n];
-        for (k, &rk) in rows[..=i].iter().enumerate() {
-            let rk = &a[rk * n..(rk + 1) * n];
-            g[i * r + k] = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
+    if fixed!(r, gram_fixed(g, a, rows, n)).is_none() {
+        for (i, &ri) in rows.iter().enumerate() {
+            let ri = &a[ri * n..(ri + 1) * n];
+            for (k, &rk) in rows[..=i].iter().enumerate() {
+                let rk = &a[rk * n..(rk + 1) * n];
+                g[i * r + k] = ri.iter().zip(rk).map(|(x, y)| x * y).sum();
+            }
         }
     }
     ch.factor().ratio()
+}
+
+/// The lower triangle of [`gram_cholesky`]'s matrix for `R` rows.
+// Index loops over constant bounds are what the compiler unrolls.
+#[allow(clippy::needless_range_loop)]
+fn gram_fixed<const R: usize>(g: &mut [f64], a: &[f64], rows: &[usize], n: usize) {
+    let (g, rows) = (&mut g[..R * R], &rows[..R]);
+    let mut acc = [[0.0_f64; R]; R];
+    let mut start = [0_usize; R];
+    for i in 0..R {
+        start[i] = rows[i] * n;
+    }
+    for j in 0..n {
+        let mut col = [0.0_f64; R];
+        for i in 0..R {
+            col[i] = a[start[i] + j];
+        }
+        for i in 0..R {
+            for k in 0..=i {
+                acc[i][k] += col[i] * col[k];
+            }
+        }
+    }
+    for i in 0..R {
+        for k in 0..=i {
+            g[i * R + k] = acc[i][k];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -520,21 +626,20 @@ mod tests {
                 residual(&x, &s) < tol * n as f64 * n as f64,
                 "Cholesky n = {n}"
             );
-            // Three columns side by side: b, 2b, −b.
-            let mut xs: Vec<f64> = b.iter().flat_map(|&v| [v, 2.0 * v, -v]).collect();
-            ch.solve_rows(&mut xs, 3);
-            for (i, xi) in x.iter().enumerate() {
-                for (c, f) in [1.0, 2.0, -1.0].into_iter().enumerate() {
-                    assert!(
-                        (xs[3 * i + c] - f * xi).abs() <= 8.0 * f64::EPSILON * xi.abs().max(1.0),
-                        "Cholesky columns n = {n}"
-                    );
-                }
-            }
+            // The explicit inverse: its product with b has the same residual.
+            let mut inv = vec![0.0; n * n];
+            ch.inverse_into(&mut inv);
+            let z: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| inv[i * n + j] * b[j]).sum())
+                .collect();
+            assert!(
+                residual(&z, &s) < tol * n as f64 * n as f64,
+                "Cholesky inverse n = {n}"
+            );
         }
     }
 
-    /// The Cholesky solves agree with the
+    /// The Cholesky solves and the explicit inverse agree with the
     /// independent partial-pivoting LU on symmetric positive definite matrices of the
     /// sizes of a mechanism's Gram matrices, `n` = 1 to 12, some with scales spread
     /// over twelve orders of magnitude (which equilibration removes): the two solutions
@@ -570,11 +675,27 @@ mod tests {
                     (0..n).map(|i| if i == n / 2 { 1.0 } else { 0.0 }).collect(),
                     vec![1.0; n],
                 ];
-                let mut rows: Vec<f64> = (0..n)
-                    .flat_map(|i| cols.iter().map(move |c| c[i]))
+                let mut inv = vec![0.0; n * n];
+                ch.inverse_into(&mut inv);
+                // The columns side by side: the identity's give the inverse.
+                let mut e: Vec<f64> = (0..n * n)
+                    .map(|k| if k / n == k % n { 1.0 } else { 0.0 })
                     .collect();
-                ch.solve_rows(&mut rows, 3);
-                for (c, b) in cols.iter().enumerate() {
+                ch.solve_rows(&mut e, n);
+                for i in 0..n {
+                    for k in 0..n {
+                        let size = (inv[i * n + i] * inv[k * n + k]).sqrt();
+                        #[allow(clippy::cast_precision_loss)]
+                        let tol = 1e3 * f64::EPSILON * size * (n * n) as f64;
+                        let err = (e[i * n + k] - inv[i * n + k]).abs();
+                        assert!(err <= tol, "solve_rows n = {n} spread {spread}: {err:e}");
+                    }
+                }
+                for b in &cols {
+                    // The explicit inverse times b against the solve.
+                    let z: Vec<f64> = (0..n)
+                        .map(|i| (0..n).map(|j| inv[i * n + j] * b[j]).sum())
+                        .collect();
                     let (mut x, mut y) = (b.clone(), b.clone());
                     ch.solve(&mut x);
                     lu.solve(&mut y);
@@ -588,9 +709,66 @@ mod tests {
                             err <= tol,
                             "solve n = {n} spread {spread}: {err:e} > {tol:e}"
                         );
-                        let err = ((rows[3 * i + c] - x[i]) * d[i]).abs();
-                        assert!(err <= tol, "solve_rows n = {n} spread {spread}: {err:e}");
+                        let err = ((z[i] - y[i]) * d[i]).abs();
+                        assert!(err <= tol, "inverse n = {n} spread {spread}: {err:e}");
                     }
+                }
+            }
+        }
+    }
+
+    /// `gram_cholesky` forms $A_R A_R^\mathsf{T}$ of chosen rows (in a chosen order)
+    /// exactly as the dot products of the rows do, for 1 to 12 rows (the unrolled
+    /// kernels and the loops), and its explicit inverse is symmetric with
+    /// $G G^{-1} = I$ to round-off times the condition (the rows from a sine of a
+    /// square, well conditioned).
+    #[test]
+    fn gram_of_rows_and_its_inverse() {
+        let n = 15_usize;
+        #[allow(clippy::cast_precision_loss)]
+        let a: Vec<f64> = (0..2 * 12 * n)
+            .map(|k| (0.37 * (k * k) as f64 + 0.2).sin())
+            .collect();
+        for r in 1..=12_usize {
+            // Every other row, backwards.
+            let rows: Vec<usize> = (0..r).map(|i| 2 * (r - 1 - i) + 1).collect();
+            let mut ch = SmallCholesky::new(r);
+            assert!(gram_cholesky(&mut ch, &a, &rows, n) > 0.0);
+            let g: Vec<f64> = (0..r * r)
+                .map(|k| {
+                    let (ri, rk) = (rows[k / r], rows[k % r]);
+                    (0..n).map(|j| a[ri * n + j] * a[rk * n + j]).sum()
+                })
+                .collect();
+            // The factor holds L and Lᵀ now; compare through its inverse.
+            let mut inv = vec![0.0; r * r];
+            ch.inverse_into(&mut inv);
+            for i in 0..r {
+                for k in 0..r {
+                    assert_eq!(inv[i * r + k].to_bits(), inv[k * r + i].to_bits());
+                    let e: f64 = (0..r).map(|j| g[i * r + j] * inv[j * r + k]).sum();
+                    let want = if i == k { 1.0 } else { 0.0 };
+                    #[allow(clippy::cast_precision_loss)]
+                    let tol = 1e3 * f64::EPSILON * (r * r) as f64;
+                    assert!((e - want).abs() <= tol, "r = {r}: G G⁻¹ {e} at ({i}, {k})");
+                }
+            }
+            // The lower triangle as formed, before factoring.
+            let mut check = SmallCholesky::new(r);
+            let formed = {
+                let m = check.matrix_mut();
+                if fixed!(r, gram_fixed(m, &a, &rows, n)).is_none() {
+                    for i in 0..r {
+                        for k in 0..=i {
+                            m[i * r + k] = g[i * r + k];
+                        }
+                    }
+                }
+                m.to_vec()
+            };
+            for i in 0..r {
+                for k in 0..=i {
+                    assert_eq!(formed[i * r + k], g[i * r + k], "r = {r} ({i}, {k})");
                 }
             }
         }

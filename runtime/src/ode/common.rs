@@ -261,7 +261,12 @@ impl PiController {
         let err = if err.is_finite() { err } else { f64::MAX };
         let fac11 = err.powf(self.expo1);
         if err <= 1.0 {
-            let fac = fac11 / self.facold.powf(self.beta);
+            // Without stabilization (DOP853) the divisor is exactly 1.
+            let fac = if self.beta == 0.0 {
+                fac11
+            } else {
+                fac11 / self.facold.powf(self.beta)
+            };
             let fac = (fac / self.safe).min(self.facc1).max(self.facc2);
             self.facold = err.max(1e-4);
             (h / fac, true)

@@ -37,22 +37,56 @@ pub struct Dop853(RkDriver<Dp853>);
 pub(crate) struct Dp853 {
     /// Whether `cont` describes the last step.
     dense_ready: bool,
+    /// With `dense_output`, the interpolant is prepared only on the steps that reach
+    /// this time (every step when `None`), see [`Dop853::dense_output_from`].
+    dense_from: Option<f64>,
     /// Stage derivatives 1–16 (index = stage − 1).
     k: [Vec<f64>; 16],
     /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f).
     cont: [Vec<f64>; 8],
 }
 
+/// Components [`combine`] sums together (two SSE2 registers).
+const LANES: usize = 4;
+
 /// `out = y + h * sum_j a_j k_j` over the listed coefficients.
+///
+/// Four components at a time with the sums in registers: each entry sees the
+/// operations of a pass per coefficient ($o \leftarrow y$, then $o \mathrel{+}=
+/// (h a_j) k_j$ in the order of the list), without storing and reloading `out` once
+/// per coefficient (stage 12 has eleven).
 #[inline]
 fn combine(out: &mut [f64], y: &[f64], h: f64, coeffs: &[(usize, f64)], k: &[Vec<f64>]) {
-    out.copy_from_slice(y);
+    let n = out.len();
+    let mut l0 = 0;
+    while l0 + LANES <= n {
+        combine_lanes::<LANES>(out, y, h, coeffs, k, l0);
+        l0 += LANES;
+    }
+    for l0 in l0..n {
+        combine_lanes::<1>(out, y, h, coeffs, k, l0);
+    }
+}
+
+/// [`combine`] for the components `l0..l0 + W`.
+#[inline(always)]
+fn combine_lanes<const W: usize>(
+    out: &mut [f64],
+    y: &[f64],
+    h: f64,
+    coeffs: &[(usize, f64)],
+    k: &[Vec<f64>],
+    l0: usize,
+) {
+    let mut s = <[f64; W]>::try_from(&y[l0..l0 + W]).expect("W entries");
     for &(j, a) in coeffs {
         let ha = h * a;
-        for (o, kj) in out.iter_mut().zip(&k[j]) {
-            *o += ha * kj;
+        let kj = <&[f64; W]>::try_from(&k[j][l0..l0 + W]).expect("W entries");
+        for (s, kj) in s.iter_mut().zip(kj) {
+            *s += ha * kj;
         }
     }
+    out[l0..l0 + W].copy_from_slice(&s);
 }
 
 impl Dop853 {
@@ -65,6 +99,7 @@ impl Dop853 {
         let ctrl = PiController::new(1.0 / 8.0, 0.0, 0.9, 0.333, 6.0);
         let m = Dp853 {
             dense_ready: false,
+            dense_from: None,
             k: std::array::from_fn(|_| v()),
             cont: std::array::from_fn(|_| v()),
         };
@@ -74,6 +109,15 @@ impl Dop853 {
     /// The options in use.
     pub fn options(&self) -> &OdeOptions {
         &self.0.st.opts
+    }
+
+    /// With `dense_output` on, prepares the interpolant (three evaluations) only on the
+    /// accepted steps that reach `t` in the direction of integration; `None` (the
+    /// default): on every step. A caller that interpolates at known times sets the
+    /// next of them before each step; [`interpolate`](Integrator::interpolate) on a
+    /// step without the interpolant fails with [`OdeError::DenseOutputUnavailable`].
+    pub fn dense_output_from(&mut self, t: Option<f64>) {
+        self.0.method_mut().dense_from = t;
     }
 }
 
@@ -123,6 +167,40 @@ impl Dp853 {
     }
 }
 
+impl Dp853 {
+    /// The error sums of [`attempt`](EmbeddedRk::attempt) for the components
+    /// `l0..l0 + W`: the two error estimates summed in registers coefficient by
+    /// coefficient (each entry sees the operations of `dop853.f` in their order), then
+    /// added to `e3` and `e5` component by component, in order.
+    #[inline(always)]
+    fn error_lanes<const W: usize>(&self, st: &RkState, l0: usize, e3: &mut f64, e5: &mut f64) {
+        let (mut err3, mut err5) = ([0.0; W], [0.0; W]);
+        let lanes = |j: usize| <&[f64; W]>::try_from(&self.k[j][l0..l0 + W]).expect("W entries");
+        for &(j, b) in A[FSAL] {
+            for (e, k) in err3.iter_mut().zip(lanes(j)) {
+                *e += b * k;
+            }
+        }
+        for &(j, b) in BHH {
+            for (e, k) in err3.iter_mut().zip(lanes(j)) {
+                *e -= b * k;
+            }
+        }
+        for &(j, c) in ER {
+            for (e, k) in err5.iter_mut().zip(lanes(j)) {
+                *e += c * k;
+            }
+        }
+        let tol = &st.opts.tol;
+        for (w, (err3, err5)) in err3.iter().zip(&err5).enumerate() {
+            let i = l0 + w;
+            let sk = tol.atol(i) + tol.rtol * st.y[i].abs().max(st.y_new[i].abs());
+            *e3 += (err3 / sk) * (err3 / sk);
+            *e5 += (err5 / sk) * (err5 / sk);
+        }
+    }
+}
+
 impl EmbeddedRk for Dp853 {
     const ORDER: i32 = 8;
     const FSAL: usize = FSAL;
@@ -145,23 +223,15 @@ impl EmbeddedRk for Dp853 {
         if check_state(st.t + h, &st.y_new).is_err() {
             return Ok(f64::INFINITY);
         }
-        let tol = &st.opts.tol;
         let (mut e5, mut e3) = (0.0, 0.0);
-        for i in 0..st.y.len() {
-            let sk = tol.atol(i) + tol.rtol * st.y[i].abs().max(st.y_new[i].abs());
-            let mut err3 = 0.0;
-            for &(j, b) in A[FSAL] {
-                err3 += b * self.k[j][i];
-            }
-            for &(j, b) in BHH {
-                err3 -= b * self.k[j][i];
-            }
-            let mut err5 = 0.0;
-            for &(j, e) in ER {
-                err5 += e * self.k[j][i];
-            }
-            e3 += (err3 / sk) * (err3 / sk);
-            e5 += (err5 / sk) * (err5 / sk);
+        let n = st.y.len();
+        let mut l0 = 0;
+        while l0 + LANES <= n {
+            self.error_lanes::<LANES>(st, l0, &mut e3, &mut e5);
+            l0 += LANES;
+        }
+        for l0 in l0..n {
+            self.error_lanes::<1>(st, l0, &mut e3, &mut e5);
         }
         let deno = if e5 + 0.01 * e3 > 0.0 {
             e5 + 0.01 * e3
@@ -171,8 +241,9 @@ impl EmbeddedRk for Dp853 {
         Ok(h.abs() * e5 * (1.0 / (st.y.len() as f64 * deno)).sqrt())
     }
 
-    /// The FSAL stage $f(t_{\text{new}}, y_{n+1})$ and, with `dense_output`, the dense
-    /// stages and the interpolant.
+    /// The FSAL stage $f(t_{\text{new}}, y_{n+1})$ and, with `dense_output` (on a step
+    /// that reaches [`dense_from`](Self::dense_from)), the dense stages and the
+    /// interpolant.
     fn accept<S: OdeSystem + ?Sized>(
         &mut self,
         st: &mut RkState,
@@ -182,7 +253,8 @@ impl EmbeddedRk for Dp853 {
     ) -> Result<(), OdeError> {
         let mut fsal = eval(sys, &mut st.stats, t_new, &st.y_new, &mut self.k[FSAL]);
         self.dense_ready = false;
-        if fsal.is_ok() && st.opts.dense_output {
+        let wanted = self.dense_from.is_none_or(|td| (t_new - td) * h >= 0.0);
+        if fsal.is_ok() && st.opts.dense_output && wanted {
             fsal = self.store_dense(st, sys, h);
             self.dense_ready = fsal.is_ok();
         }

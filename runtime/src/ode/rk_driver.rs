@@ -139,6 +139,11 @@ impl<M: EmbeddedRk> RkDriver<M> {
         self.st.y.len()
     }
 
+    /// The method's own part.
+    pub(crate) fn method_mut(&mut self) -> &mut M {
+        &mut self.m
+    }
+
     pub(crate) fn t(&self) -> f64 {
         self.st.t
     }

@@ -12,7 +12,7 @@
 //!
 //! **Newton.** The iteration starts from the integrator's own prediction (off the
 //! manifold by the local error) and is a chord iteration with the map
-//! $P = N^\mathsf{T}(N N^\mathsf{T})^{-1}$ made at the anchor ($\Delta q = -P\,C_R$), so an
+//! $P = N^\mathsf{T}(N N^\mathsf{T})^{-1}$ of the anchor ($\Delta q = -P\,C_R$), so an
 //! evaluation factors and solves nothing: one update is one product with an
 //! `n × r` matrix. It converges
 //! linearly with a rate proportional to the distance from the anchor; the rate per unit
@@ -29,8 +29,9 @@
 //! of the anchor's $G_a = J_a J_a^\mathsf{T}$ (made once per step) converges to the
 //! orthogonal projection at $q$ (every update lies in the range of $J(q)^\mathsf{T}$) at
 //! the rate $\lVert I - J J^\mathsf{T} G_a^{-1}\rVert$, proportional to the distance from
-//! the anchor like the positions'; each update is a product with the pattern of $J$ and
-//! one with an `m × m` matrix. It stops like the positions' iteration. An iteration
+//! the anchor like the positions'; each update is a product with the pattern of $J$
+//! (by rows), one with an `m × m` matrix and one with the pattern of $J^\mathsf{T}$ (by
+//! columns: the pattern is laid out both ways once, so no sum goes through memory). It stops like the positions' iteration. An iteration
 //! that does not contract, and models whose redundant constraints were dropped, hand
 //! over to the factored projection at the point ([`Point::project_velocities`]). Moving the velocities along the anchor's normals
 //! instead (the derivative of the chart's map, which keeps the tangential velocities
@@ -84,7 +85,8 @@ impl From<EvalError> for ChartFailure {
 }
 
 /// The maps of one anchor: where they were made, its Jacobian and the explicit
-/// inverses of its Gram matrices.
+/// inverses of its Gram matrices (formed from the Cholesky factor as
+/// $D L^{-\mathsf{T}} L^{-1} D$, see [`SmallCholesky::inverse_into`]).
 #[derive(Debug)]
 struct Maps {
     /// The anchor $q_a$.
@@ -150,34 +152,29 @@ impl Maps {
         }
         self.all_rows = self.rows.len() == self.slot.len()
             && self.rows.iter().enumerate().all(|(k, &i)| k == i);
-        let identity = |map: &mut [f64]| {
-            map.fill(0.0);
-            for k in 0..m {
-                map[k * m + k] = 1.0;
-            }
-        };
         if m > r {
             gram.resize(m);
             let ratio = gram_cholesky(gram, &self.normals, &self.rows, n);
-            identity(&mut self.velocity_map);
-            gram.solve_rows(&mut self.velocity_map, m);
+            gram.inverse_into(&mut self.velocity_map);
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
         gram.resize(r);
-        let ratio = normal_map(
-            gram,
-            &mut self.position_map,
-            &self.normals,
-            &self.rows[..r],
-            n,
-        );
+        let ratio = gram_cholesky(gram, &self.normals, &self.rows[..r], n);
+        for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
+            out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
+        }
+        gram.solve_rows(&mut self.position_map, n);
         if m == r {
-            identity(&mut self.velocity_map);
-            gram.solve_rows(&mut self.velocity_map, m);
+            gram.inverse_into(&mut self.velocity_map);
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
         self.ratio = ratio;
         Ok(ratio)
+    }
+
+    /// A position update with these maps (see [`update`]).
+    fn update(&self, mu: &[f64], dx: &mut [f64], x: &mut [f64], tol: (f64, f64)) -> (f64, f64) {
+        update(&self.position_map, &mu[..self.rows_h], x, dx, tol)
     }
 
     /// Whether the velocity iteration with these maps serves the rows of `p` (see
@@ -193,7 +190,7 @@ impl Maps {
     fn distance(&self, q: &[f64]) -> f64 {
         q.iter()
             .zip(&self.anchor)
-            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()))
+            .fold(0.0_f64, |a, (x, y)| larger(a, (x - y).abs()))
     }
 }
 
@@ -210,16 +207,19 @@ pub(crate) struct Chart {
     /// made for (`None`: no staged maps).
     staged_for: Option<f64>,
     staged_q: Vec<f64>,
-    /// The factorization of a Gram matrix, scratch for the maps.
-    gram: SmallCholesky,
     /// $G_a^{-1}$ times the velocity residuals.
     nu: Vec<f64>,
+    /// The factorization of a Gram matrix, scratch for the maps.
+    gram: SmallCholesky,
     /// The velocity residuals of every constraint row.
     vel: Vec<f64>,
     /// The residuals of the current update.
     mu: Vec<f64>,
-    /// The current update.
+    /// The current position update.
     dx: Vec<f64>,
+    /// The pattern of $J$ grouped by rows and by columns (made at the first velocity
+    /// iteration).
+    layout: Layout,
     /// Measured contraction rate per unit distance from the anchor.
     rate_per_distance: Option<f64>,
     /// The same, measured on the velocities' iteration.
@@ -228,27 +228,36 @@ pub(crate) struct Chart {
     atol: f64,
 }
 
-/// Writes $(A_R A_R^\mathsf{T})^{-1}A_R$ of the rows `rows` of the dense row-major `a`
-/// (`· × n`) into `map` (row-major `|R| × n`), with `gram` (of size `|R|`) as scratch;
-/// returns the pivot ratio of the Gram matrix.
-fn normal_map(
-    gram: &mut SmallCholesky,
-    map: &mut [f64],
-    a: &[f64],
-    rows: &[usize],
-    n: usize,
-) -> f64 {
-    let ratio = gram_cholesky(gram, a, rows, n);
-    for (out, &i) in map.chunks_exact_mut(n.max(1)).zip(rows) {
-        out.copy_from_slice(&a[i * n..(i + 1) * n]);
+/// `b` when it is larger than `a` (or `a` is NaN), `a` otherwise: one instruction
+/// (`maxsd`), where [`f64::max`] also tests for NaN. The maxima of the chart start
+/// from 0 and test their inputs for NaN where it matters.
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
     }
-    gram.solve_rows(map, n);
-    ratio
+}
+
+/// $y = A x$ for a symmetric row-major `A` (`k × k`, `k` the length of `x`), as
+/// $\sum_i x_i A_{i\cdot}$: contiguous rows added to `y` side by side. The dot products
+/// of the rows give the same bits (`A` is exactly symmetric); the two were not told apart
+/// in speed on andrews, the pendulum and car_axis (within 3 %, the noise).
+fn symmetric_product(a: &[f64], x: &[f64], y: &mut [f64]) {
+    let k = x.len();
+    y.fill(0.0);
+    for (row, &xi) in a.chunks_exact(k.max(1)).zip(x) {
+        for (yj, aij) in y.iter_mut().zip(row) {
+            *yj += aij * xi;
+        }
+    }
 }
 
 /// $x \leftarrow x - M^\mathsf{T}\mu$ for the map `map` (`|μ| × n`, row-major), with
 /// `dx` (length `n`) as scratch; returns the largest change and the largest in the
-/// weights $\text{atol} + \text{rtol}\,|x_j|$ (at the new values).
+/// weights $\text{atol} + \text{rtol}\,|x_j|$ (at the new values), NaN when a change is
+/// NaN.
 fn update(
     map: &[f64],
     mu: &[f64],
@@ -263,11 +272,15 @@ fn update(
             *d += a * m;
         }
     }
-    let (mut step, mut weighted) = (0.0_f64, 0.0_f64);
-    for (xj, d) in x.iter_mut().zip(&*dx) {
+    let (mut step, mut weighted, mut nan) = (0.0_f64, 0.0_f64, false);
+    for (xj, &d) in x.iter_mut().zip(&*dx) {
         *xj -= d;
-        step = step.max(d.abs());
-        weighted = weighted.max(d.abs() / (atol + rtol * xj.abs()));
+        nan |= d.is_nan();
+        step = larger(step, d.abs());
+        weighted = larger(weighted, d.abs() / (atol + rtol * xj.abs()));
+    }
+    if nan {
+        return (f64::NAN, f64::NAN);
     }
     (step, weighted)
 }
@@ -289,6 +302,7 @@ impl Chart {
             vel: vec![0.0; m],
             mu: vec![0.0; m],
             dx: vec![0.0; n],
+            layout: Layout::default(),
             rate_per_distance: None,
             velocity_rate_per_distance: None,
             rtol,
@@ -391,13 +405,8 @@ impl Chart {
             for (mu, &i) in self.mu.iter_mut().zip(&self.staged.rows[..r]) {
                 *mu = c[i];
             }
-            update(
-                &self.staged.position_map,
-                &self.mu[..r],
-                &mut p.q,
-                &mut self.dx,
-                (self.rtol, self.atol),
-            );
+            let tol = (self.rtol, self.atol);
+            self.staged.update(&self.mu, &mut self.dx, &mut p.q, tol);
             p.newton_iterations += 1;
         }
         Ok(None)
@@ -441,13 +450,8 @@ impl Chart {
                     residual,
                 });
             }
-            let (step, weighted) = update(
-                &self.maps.position_map,
-                &self.mu[..rows_h],
-                &mut p.q,
-                &mut self.dx,
-                (self.rtol, self.atol),
-            );
+            let tol = (self.rtol, self.atol);
+            let (step, weighted) = self.maps.update(&self.mu, &mut self.dx, &mut p.q, tol);
             // An update at round-off has converged, whatever rate its noise suggests.
             if step <= floor {
                 return Ok(iteration + 1);
@@ -559,6 +563,10 @@ impl Chart {
         kappa: f64,
         staged: bool,
     ) -> Option<usize> {
+        if !self.layout.built {
+            // Once per simulation (the patterns are the model's).
+            self.layout = Layout::new(info, qd.len(), self.vel.len());
+        }
         let maps = if staged { &self.staged } else { &self.maps };
         let rate = self
             .velocity_rate_per_distance
@@ -568,12 +576,11 @@ impl Chart {
             nu: &mut self.nu,
             vel: &mut self.vel,
             mu: &mut self.mu,
-            dx: &mut self.dx,
         };
         let (updates, measured) = velocity_iteration(
             maps,
             scratch,
-            info,
+            &self.layout,
             terms,
             qd,
             (rate, kappa),
@@ -591,7 +598,119 @@ struct Scratch<'a> {
     nu: &'a mut [f64],
     vel: &'a mut [f64],
     mu: &'a mut [f64],
-    dx: &'a mut [f64],
+}
+
+/// The combined pattern of $J$ (the holonomic rows, then the non-holonomic ones as
+/// rows `mh..m`) grouped by rows and by columns, so that each sum of the velocity
+/// iteration ($J\dot q$ by rows, $J^\mathsf{T}\nu$ by columns) is carried in a register
+/// instead of scattered into memory entry by entry (consecutive entries of a pattern
+/// share a row, and each `+=` waited for the store of the one before). Within a row
+/// or a column the entries keep their order in the patterns, so the sums are the
+/// scatter's, bit for bit.
+#[derive(Debug, Default)]
+struct Layout {
+    built: bool,
+    /// The number of holonomic rows.
+    mh: usize,
+    /// Row `i`'s entries are `by_row[row_start[i]..row_start[i + 1]]`: its column and
+    /// the index of its value among the pattern values of $C_q$ (row `i < mh`) or of
+    /// $G$.
+    row_start: Vec<usize>,
+    by_row: Vec<(u32, u32)>,
+    /// Column `j`'s holonomic entries are `by_col[col_start[j]..col_split[j]]`, its
+    /// non-holonomic ones `by_col[col_split[j]..col_start[j + 1]]`: each its row (of
+    /// all `m`) and the index of its value.
+    col_start: Vec<usize>,
+    col_split: Vec<usize>,
+    by_col: Vec<(u32, u32)>,
+}
+
+impl Layout {
+    /// The layout of the patterns of `info`, for `n` coordinates and `m` rows.
+    fn new(info: &Info, n: usize, m: usize) -> Self {
+        let mh = info.nh();
+        let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
+        let entries = || {
+            let h = hol
+                .iter()
+                .enumerate()
+                .map(|(k, &(r, c))| (r as usize, c, k, true));
+            let g = non
+                .iter()
+                .enumerate()
+                .map(move |(k, &(r, c))| (mh + r as usize, c, k, false));
+            h.chain(g)
+        };
+        let index = |k: usize| u32::try_from(k).expect("pattern index fits u32");
+        let mut row_start = vec![0; m + 1];
+        for (r, ..) in entries() {
+            row_start[r + 1] += 1;
+        }
+        for i in 0..m {
+            row_start[i + 1] += row_start[i];
+        }
+        let mut by_row = vec![(0, 0); hol.len() + non.len()];
+        let mut fill = row_start.clone();
+        for (r, c, k, _) in entries() {
+            by_row[fill[r]] = (c, index(k));
+            fill[r] += 1;
+        }
+        let (mut count_h, mut count_g) = (vec![0; n], vec![0; n]);
+        for (_, c, _, h) in entries() {
+            if h {
+                count_h[c as usize] += 1;
+            } else {
+                count_g[c as usize] += 1;
+            }
+        }
+        let mut col_start = vec![0; n + 1];
+        let mut col_split = vec![0; n];
+        for j in 0..n {
+            col_split[j] = col_start[j] + count_h[j];
+            col_start[j + 1] = col_split[j] + count_g[j];
+        }
+        let mut by_col = vec![(0, 0); hol.len() + non.len()];
+        let (mut fill_h, mut fill_g) = (col_start.clone(), col_split.clone());
+        for (r, c, k, h) in entries() {
+            let fill = if h { &mut fill_h } else { &mut fill_g };
+            by_col[fill[c as usize]] = (index(r), index(k));
+            fill[c as usize] += 1;
+        }
+        Self {
+            built: true,
+            mh,
+            row_start,
+            by_row,
+            col_start,
+            col_split,
+            by_col,
+        }
+    }
+
+    /// $J\dot q + [C_t; g]$ of every row into `vel`, with the pattern values of `terms`.
+    #[inline(always)]
+    fn residuals(&self, terms: VelocityTerms<'_>, qd: &[f64], vel: &mut [f64]) {
+        let rates = terms.ct.iter().chain(terms.bias);
+        for (i, (v, &start)) in vel.iter_mut().zip(rates).enumerate() {
+            let entries = &self.by_row[self.row_start[i]..self.row_start[i + 1]];
+            let values = if i < self.mh { terms.cq } else { terms.g };
+            *v = entries
+                .iter()
+                .fold(start, |s, &(c, k)| s + values[k as usize] * qd[c as usize]);
+        }
+    }
+
+    /// $(J^\mathsf{T}\nu)_j$ with the pattern values `(cq, g)` and `nu` of every row.
+    #[inline(always)]
+    fn column(&self, j: usize, (cq, g): (&[f64], &[f64]), nu: &[f64]) -> f64 {
+        let (a, b, e) = (self.col_start[j], self.col_split[j], self.col_start[j + 1]);
+        let d = self.by_col[a..b]
+            .iter()
+            .fold(0.0, |s, &(r, k)| s + cq[k as usize] * nu[r as usize]);
+        self.by_col[b..e]
+            .iter()
+            .fold(d, |s, &(r, k)| s + g[k as usize] * nu[r as usize])
+    }
 }
 
 /// The velocity iteration of [`Chart::correct_velocities`] with the maps `maps`, from
@@ -600,7 +719,7 @@ struct Scratch<'a> {
 fn velocity_iteration(
     maps: &Maps,
     s: Scratch<'_>,
-    info: &Info,
+    layout: &Layout,
     terms: VelocityTerms<'_>,
     qd: &mut [f64],
     (mut rate, kappa): (f64, f64),
@@ -610,68 +729,51 @@ fn velocity_iteration(
     if m == 0 {
         return (Some(0), None);
     }
-    let mh = info.nh();
-    let (vel, mu, nu, dx) = (&mut s.vel[..], &mut s.mu[..m], &mut s.nu[..m], &mut *s.dx);
+    let (vel, gathered, nu) = (&mut s.vel[..], &mut s.mu[..m], &mut s.nu[..m]);
+    let dense = maps.all_rows;
+    let (cq, g) = (terms.cq, terms.g);
     let mut previous: Option<f64> = None;
     let mut rate_measured = None;
     for iteration in 0..MAX_ITERATIONS {
-        // The residuals J q̇ + [C_t; g] of the rows.
-        vel[..mh].copy_from_slice(terms.ct);
-        vel[mh..].copy_from_slice(terms.bias);
-        for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
-            vel[r as usize] += v * qd[c as usize];
-        }
-        let vn = &mut vel[mh..];
-        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
-            vn[r as usize] += v * qd[c as usize];
-        }
-        // ν = G_a⁻¹ μ, Δq̇ = Jᵀν.
-        let dense = maps.all_rows;
-        if dense {
-            mu.copy_from_slice(&vel[..m]);
+        // The residuals J q̇ + [C_t; g] of the rows, row by row.
+        layout.residuals(terms, qd, vel);
+        // ν = G_a⁻¹ μ (of the rows the maps were made for).
+        let mu: &[f64] = if dense {
+            &vel[..m]
         } else {
-            for (mu, &i) in mu.iter_mut().zip(&maps.rows) {
+            for (mu, &i) in gathered.iter_mut().zip(&maps.rows) {
                 *mu = vel[i];
             }
-        }
-        for (nu, row) in nu.iter_mut().zip(maps.velocity_map.chunks_exact(m)) {
-            *nu = row.iter().zip(&*mu).map(|(a, b)| a * b).sum();
-        }
-        dx.fill(0.0);
-        if dense {
-            let (nh, nn) = nu.split_at(mh);
-            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
-                dx[c as usize] += v * nh[r as usize];
-            }
-            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
-                dx[c as usize] += v * nn[r as usize];
-            }
+            &*gathered
+        };
+        symmetric_product(&maps.velocity_map, mu, nu);
+        // ν of every row (0 for those not projected).
+        let full: &[f64] = if dense {
+            nu
         } else {
-            for (&(r, c), v) in info.holonomic_pattern.iter().zip(terms.cq) {
-                if let Some(nu) = nu.get(maps.slot[r as usize]) {
-                    dx[c as usize] += v * nu;
-                }
+            vel.fill(0.0);
+            for (&nu, &i) in nu.iter().zip(&maps.rows) {
+                vel[i] = nu;
             }
-            for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(terms.g) {
-                if let Some(nu) = nu.get(maps.slot[mh + r as usize]) {
-                    dx[c as usize] += v * nu;
-                }
-            }
-        }
-        let (mut step, mut weighted, mut size) = (0.0_f64, 0.0_f64, 0.0_f64);
-        for (xj, d) in qd.iter_mut().zip(&*dx) {
-            size = size.max(xj.abs());
+            vel
+        };
+        // Δq̇ = Jᵀν column by column, and the update with its norms.
+        let (mut step, mut weighted, mut size, mut nan) = (0.0_f64, 0.0_f64, 0.0_f64, false);
+        for (j, xj) in qd.iter_mut().enumerate() {
+            let d = layout.column(j, (cq, g), full);
+            size = larger(size, xj.abs());
             *xj -= d;
-            step = step.max(d.abs());
-            weighted = weighted.max(d.abs() / (atol + rtol * xj.abs()));
+            nan |= d.is_nan();
+            step = larger(step, d.abs());
+            weighted = larger(weighted, d.abs() / (atol + rtol * xj.abs()));
+        }
+        if nan || !step.is_finite() {
+            return (None, rate_measured);
         }
         // The round-off of q̇ (its size before the update, as measured before).
         let floor = 8.0 * f64::EPSILON * size;
         if step <= floor {
             return (Some(iteration + 1), rate_measured);
-        }
-        if !step.is_finite() {
-            return (None, rate_measured);
         }
         if let Some(p) = previous {
             let measured = weighted / p;
@@ -700,4 +802,83 @@ pub(crate) struct VelocityTerms<'a> {
     pub g: &'a [f64],
     pub ct: &'a [f64],
     pub bias: &'a [f64],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanism::Symbol;
+
+    const ROW: Symbol = Symbol { name: "c", doc: "" };
+
+    /// The layout's row and column sums are the scatter's over the patterns, bit for
+    /// bit, on patterns whose entries are not sorted (rows revisited, an empty row and
+    /// column, non-holonomic rows sharing columns with holonomic ones); the values are
+    /// chosen so that the order of the additions shows in the last bits.
+    #[test]
+    fn layout_sums_are_the_scatters() {
+        static HOLONOMIC: [(u32, u32); 7] =
+            [(1, 2), (0, 0), (1, 0), (0, 3), (2, 4), (1, 3), (0, 2)];
+        static NONHOLONOMIC: [(u32, u32); 4] = [(1, 0), (0, 4), (1, 2), (0, 0)];
+        static ROWS: [Symbol; 3] = [ROW; 3];
+        static NH_ROWS: [Symbol; 3] = [ROW; 3];
+        let info = Info {
+            holonomic: &ROWS,
+            nonholonomic: &NH_ROWS[..2],
+            holonomic_pattern: &HOLONOMIC,
+            nonholonomic_pattern: &NONHOLONOMIC,
+            ..Info::EMPTY
+        };
+        // n = 6 (column 5 empty), m = 5 (row 2 has one entry, rows 3-4 non-holonomic).
+        let (n, m, mh) = (6, 5, 3);
+        let layout = Layout::new(&info, n, m);
+        #[allow(clippy::cast_precision_loss)]
+        let value = |k: usize| 1.0 + (0.37 * (k * k + 1) as f64).sin() * 1e-3;
+        let cq: Vec<f64> = (0..HOLONOMIC.len()).map(|k| 3.0 * value(k)).collect();
+        let g: Vec<f64> = (0..NONHOLONOMIC.len())
+            .map(|k| -7.0 * value(k + 9))
+            .collect();
+        let ct: Vec<f64> = (0..mh).map(|i| value(i + 20)).collect();
+        let bias: Vec<f64> = (0..m - mh).map(|i| value(i + 30)).collect();
+        let qd: Vec<f64> = (0..n).map(|j| 1e3 * value(j + 40) - 999.0).collect();
+        let nu: Vec<f64> = (0..m).map(|i| value(i + 50) / 3.0).collect();
+        let terms = VelocityTerms {
+            cq: &cq,
+            g: &g,
+            ct: &ct,
+            bias: &bias,
+        };
+        let mut vel = vec![0.0; m];
+        layout.residuals(terms, &qd, &mut vel);
+        let mut scatter = [ct.clone(), bias.clone()].concat();
+        for (&(r, c), v) in HOLONOMIC.iter().zip(&cq) {
+            scatter[r as usize] += v * qd[c as usize];
+        }
+        for (&(r, c), v) in NONHOLONOMIC.iter().zip(&g) {
+            scatter[mh + r as usize] += v * qd[c as usize];
+        }
+        for (a, b) in vel.iter().zip(&scatter) {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "J q̇ + b: {vel:?} against {scatter:?}"
+            );
+        }
+        let mut dx = vec![0.0; n];
+        for (&(r, c), v) in HOLONOMIC.iter().zip(&cq) {
+            dx[c as usize] += v * nu[r as usize];
+        }
+        for (&(r, c), v) in NONHOLONOMIC.iter().zip(&g) {
+            dx[c as usize] += v * nu[mh + r as usize];
+        }
+        for (j, d) in dx.iter().enumerate() {
+            let column = layout.column(j, (&cq, &g), &nu);
+            assert_eq!(
+                column.to_bits(),
+                d.to_bits(),
+                "(Jᵀν)_{j}: {column} against {d}"
+            );
+        }
+        assert_eq!(layout.column(5, (&cq, &g), &nu), 0.0);
+    }
 }

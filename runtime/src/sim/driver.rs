@@ -343,12 +343,21 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             SimErrorKind::Integrator(OdeError::InvalidStepSize { h }),
         ));
     }
+    // Dense output only where the run interpolates: rows on a grid or at given times,
+    // and the location of contact events. DOP853 pays three evaluations per step for
+    // it (the other methods have it free); a run with rows at the steps or at the end
+    // only lands on them.
+    let interpolates = !times.is_empty() || rec.sys.contacts.is_some();
+    // Without contacts only the rows interpolate: DOP853 then prepares its interpolant
+    // on the steps that reach the next row, not on the steps between rows of a grid
+    // coarser than the steps.
+    let rows_only = rec.sys.contacts.is_none();
     let opts = OdeOptions {
         tol: Tolerances::new(sim.rtol, sim.atol),
         h_init: sim.h_init.map(|h| h.max(super::min_step(t0, t_end))),
         h_max,
         max_steps: sim.max_steps,
-        dense_output: true,
+        dense_output: interpolates,
     };
     let mut stepper = match Stepper::new(sim.method, dim, opts) {
         Ok(s) => s,
@@ -365,6 +374,13 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         return Err(rec.fail(Some(&stepper), kind));
     }
 
+    // Projection with an explicit pair: the next step starts from the projected state
+    // with the FSAL derivative of the unprojected one, as Adams keeps its differences
+    // (ARCHITECTURE.md, "the FSAL derivative survives the projection"): the
+    // projection moves the state by about the local error, so the derivative's error
+    // enters the next step multiplied by h, below the local error of the method.
+    let keeps_fsal = sim.formulation == Formulation::Projection
+        && matches!(sim.method, Method::Dopri5 | Method::Dop853);
     let mut yout = vec![0.0; dim];
     // A closing located on a dense output coarser than the steps is moved to where the
     // steps put it (`contacts::refine`), which needs the state at the start of the step.
@@ -401,6 +417,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             y_start.copy_from_slice(stepper.y());
         }
         let partitions = rec.sys.point.kin.repartitions();
+        if rows_only {
+            // The interpolant on the steps that reach the next row only.
+            let next = times.get(next_out).copied().unwrap_or(f64::INFINITY);
+            stepper.dense_output_from(Some(next));
+        }
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
@@ -500,14 +521,19 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         // point of the chart the integrator has just evaluated, polished; the
         // right-hand side is invariant to the move, so the integrator keeps its
         // derivatives), then the anchor of the next step.
-        rec.y.copy_from_slice(stepper.y());
-        let mut correction = check!(rec.sys.keep(t, rec.y));
+        // The state is read from the integrator and, when corrected, written back.
+        let mut correction = check!(rec.sys.keep(t, stepper.y()));
+        if keeps_fsal && correction == Correction::Changed {
+            correction = Correction::SameDerivative;
+        }
         if let Some(c) = rec.sys.contacts.as_mut() {
             if check!(c.project(&mut rec.sys.point, t)) {
                 correction = Correction::Changed;
             }
         }
-        rec.sys.gather(rec.y);
+        if correction != Correction::None {
+            rec.sys.gather(rec.y);
+        }
         match correction {
             Correction::None => {}
             Correction::SameDerivative => {

@@ -71,6 +71,15 @@ impl Stepper {
         each!(self, i => i.interpolate(t, out))
     }
 
+    /// DOP853 prepares its interpolant only on the steps that reach `t` (see
+    /// [`Dop853::dense_output_from`]); the other methods have it on every step at no
+    /// cost.
+    pub fn dense_output_from(&mut self, t: Option<f64>) {
+        if let Self::Dop853(i) = self {
+            i.dense_output_from(t);
+        }
+    }
+
     pub fn set_state(&mut self, y: &[f64]) -> Result<(), OdeError> {
         each!(self, i => i.set_state(y))
     }

@@ -234,3 +234,83 @@ fn partitioning_never_lands_on_the_mirror_branch() {
         }
     }
 }
+
+/// DOP853 with projection: 12 evaluations per accepted step (stages 2–12, the FSAL
+/// stage $f(t+h, y_{n+1})$, whose derivative the next step keeps through the
+/// projection), 11 per rejected attempt and 2 at the start ($f(t_0)$ and Hairer's
+/// `HINIT`); the interpolant's three stages (14–16 of `dop853.f`) only when the run
+/// has rows to interpolate, on the same steps (ARCHITECTURE.md, "dense output only
+/// where the run interpolates").
+#[test]
+fn dop853_pays_for_dense_output_only_when_rows_interpolate() {
+    let model = pendulum::Model::default();
+    let run = |sim: Simulation<'_, _>| {
+        sim.formulation(Formulation::Projection)
+            .integrator(Method::Dop853)
+            .tolerances(1e-8, 1e-8)
+            .run(3.0)
+            .unwrap()
+    };
+    let end = run(Simulation::new(&model).output_times(&[]));
+    let steps = run(Simulation::new(&model).output_steps());
+    let grid = run(Simulation::new(&model).output_every(0.01));
+    let s = &end.stats;
+    eprintln!(
+        "steps {} rejected {} evaluations {} {} {}",
+        s.steps, s.rejected, s.rhs_evals, steps.stats.rhs_evals, grid.stats.rhs_evals
+    );
+    assert!(s.steps > 20 && s.rejected > 0, "{s:?}");
+    assert_eq!(s.rhs_evals, 12 * s.steps + 11 * s.rejected + 2);
+    for other in [&steps, &grid] {
+        assert_eq!(
+            (other.stats.steps, other.stats.rejected),
+            (s.steps, s.rejected)
+        );
+    }
+    assert_eq!(steps.stats.rhs_evals, s.rhs_evals);
+    assert_eq!(grid.stats.rhs_evals, s.rhs_evals + 3 * s.steps);
+    assert_eq!(grid.trajectory.len(), 301);
+    // The same steps: the final states agree but for the rounding of the interpolant
+    // at its end point.
+    let (a, b) = (end.final_state().unwrap(), grid.final_state().unwrap());
+    assert_eq!(a.0, b.0);
+    for (x, y) in a.1.iter().chain(a.2).zip(b.1.iter().chain(b.2)) {
+        assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{x} {y}");
+    }
+}
+
+/// On a grid coarser than the steps, DOP853 prepares its interpolant only on the
+/// steps that reach a row: three evaluations per row at most, not per step; the rows
+/// follow the exact solution (benchmark-models.md) as the steps do.
+#[test]
+fn dop853_interpolates_only_on_steps_that_reach_a_row() {
+    let model = pendulum::Model::default();
+    let run = |sim: Simulation<'_, _>| {
+        sim.formulation(Formulation::Projection)
+            .integrator(Method::Dop853)
+            .tolerances(1e-9, 1e-9)
+            .run(30.0)
+            .unwrap()
+    };
+    let end = run(Simulation::new(&model).output_times(&[]));
+    let grid = run(Simulation::new(&model).output_every(3.0));
+    let (s, g) = (&end.stats, &grid.stats);
+    eprintln!(
+        "steps {} evaluations {} -> {}, error {:.1e}",
+        s.steps,
+        s.rhs_evals,
+        g.rhs_evals,
+        max_error(&grid)
+    );
+    assert_eq!((g.steps, g.rejected), (s.steps, s.rejected));
+    assert!(s.steps > 100, "{s:?}");
+    let dense = (g.rhs_evals - s.rhs_evals) / 3;
+    assert_eq!(g.rhs_evals, s.rhs_evals + 3 * dense);
+    assert!(
+        (1..=10).contains(&dense),
+        "{dense} steps with the interpolant"
+    );
+    assert_eq!(grid.trajectory.len(), 11);
+    // Integrated results: solver tolerance × 1e3 over ten periods.
+    assert!(max_error(&grid) < 1e3 * 1e-9);
+}

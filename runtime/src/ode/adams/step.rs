@@ -103,6 +103,32 @@ fn predict_lanes<const W: usize>(
     p[l0..l0 + W].copy_from_slice(&s);
 }
 
+/// Block 4's update of the differences for the components `l0..l0 + W`, with
+/// $d = f - \phi_1$ in registers: $\phi_{k+1} = d$, $\phi_{k+2} = d - \phi_{k+2}$,
+/// then $\phi_i \mathrel{+}= d$ for $i = 1..k$ (the operations of `STEP`'s loops).
+#[inline(always)]
+fn update_lanes<const W: usize>(phi: &mut [f64], n: usize, l0: usize, k: usize, yp: &[f64]) {
+    let mut d = [0.0; W];
+    let (lo, hi) = phi.split_at_mut(k * n);
+    let (ck1, ck2) = hi.split_at_mut(n);
+    let yp = <&[f64; W]>::try_from(&yp[l0..l0 + W]).expect("W entries");
+    let phi1 = <&[f64; W]>::try_from(&lo[l0..l0 + W]).expect("W entries");
+    let a = <&mut [f64; W]>::try_from(&mut ck1[l0..l0 + W]).expect("W entries");
+    let b = <&mut [f64; W]>::try_from(&mut ck2[l0..l0 + W]).expect("W entries");
+    for w in 0..W {
+        d[w] = yp[w] - phi1[w];
+        a[w] = d[w];
+        b[w] = d[w] - b[w];
+    }
+    for i in 0..k {
+        let at = i * n + l0;
+        let col = <&mut [f64; W]>::try_from(&mut lo[at..at + W]).expect("W entries");
+        for (x, d) in col.iter_mut().zip(&d) {
+            *x += d;
+        }
+    }
+}
+
 impl Adams {
     #[inline]
     fn col(&self, i: usize) -> usize {
@@ -202,6 +228,10 @@ impl Adams {
         while l0 + LANES <= n {
             predict_lanes::<LANES>(phi, n, l0, c, k, p);
             l0 += LANES;
+        }
+        if l0 + 2 <= n {
+            predict_lanes::<2>(phi, n, l0, c, k, p);
+            l0 += 2;
         }
         for l0 in l0..n {
             predict_lanes::<1>(phi, n, l0, c, k, p);
@@ -446,21 +476,18 @@ impl Adams {
         }
         // phi_{k+1} = f - phi_1, phi_{k+2} = phi_{k+1} - phi_{k+2}, then
         // phi_i += phi_{k+1} for i = 1..=k.
-        let (lo, hi) = self.phi[..kp2 * n].split_at_mut(k * n);
-        let (ck1, ck2) = hi.split_at_mut(n);
-        for (((a, b), yp), phi1) in ck1
-            .iter_mut()
-            .zip(ck2.iter_mut())
-            .zip(&self.yp)
-            .zip(&lo[..n])
-        {
-            *a = yp - phi1;
-            *b = *a - *b;
+        let (phi, yp) = (&mut self.phi[..kp2 * n], &self.yp[..n]);
+        let mut l0 = 0;
+        while l0 + LANES <= n {
+            update_lanes::<LANES>(phi, n, l0, k, yp);
+            l0 += LANES;
         }
-        for col in lo.chunks_exact_mut(n) {
-            for (x, d) in col.iter_mut().zip(&*ck1) {
-                *x += d;
-            }
+        if l0 + 2 <= n {
+            update_lanes::<2>(phi, n, l0, k, yp);
+            l0 += 2;
+        }
+        for l0 in l0..n {
+            update_lanes::<1>(phi, n, l0, k, yp);
         }
         self.select_order_and_step(est, p5eps);
         Ok(())
