@@ -408,8 +408,8 @@ fn check_positions<M: Mechanism + ?Sized>(
 ) -> Result<(), AssemblyError> {
     let info = ws.info();
     let n = info.nq();
-    ws.eval_constraints(mech, t, q)?;
-    ws.eval_jacobian(mech, t, q)?;
+    ws.eval_constraints_with_jacobian(mech, t, q)?;
+    ws.scatter_jacobian();
     let size = 1.0 + crate::linalg::inf_norm(q);
     let violated: Vec<Violation> = (0..info.nh())
         .filter_map(|i| {

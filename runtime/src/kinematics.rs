@@ -324,11 +324,12 @@ impl Kinematics {
         }
         let tol = params.newton.tolerance;
         history.clear();
-        ws.eval_constraints(mech, t, q)?;
+        // C and C_q at the iterate (one fused evaluation): the residual, the scale of
+        // its test, and the first Newton matrix.
+        ws.eval_constraints_with_jacobian(mech, t, q)?;
+        ws.scatter_jacobian();
         let mut residual = inf_norm(&ws.c);
         history.push(residual);
-        // C_q at the iterate: the scale of the residual test, and the first Newton matrix.
-        ws.eval_jacobian(mech, t, q)?;
         let met = |ws: &Workspace, q: &[f64]| {
             scale::all_met(&ws.c, &ws.jacobian, n, tol, scale::coordinate_size(q))
         };

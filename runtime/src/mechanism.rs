@@ -453,6 +453,17 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
+    /// [`holonomic`](Self::holonomic) into `c` and
+    /// [`holonomic_jacobian`](Self::holonomic_jacobian) into `cq` in one call, so that
+    /// the generated code computes what they share (the sine and cosine of each angle,
+    /// the same lengths) once. The generator emits it for every model with holonomic
+    /// constraints; the default calls the two functions. The position projections and
+    /// the monitors of the runtime need both at one point.
+    fn holonomic_with_jacobian(&self, t: f64, q: &[f64], c: &mut [f64], cq: &mut [f64]) {
+        self.holonomic(t, q, c);
+        self.holonomic_jacobian(t, q, cq);
+    }
+
     /// The time partial `C_t` (length `m_h`); zero for scleronomic constraints.
     fn holonomic_rate(&self, t: f64, q: &[f64], out: &mut [f64]) {
         let _ = (t, q);

@@ -324,9 +324,6 @@ impl Workspace {
         self.info
     }
 
-    /// The model passed has the description this workspace was made for (same
-    /// `Info`, or one with the same name and shapes), so that its functions write
-    /// buffers of the sizes reserved here; `q` (and `qd`) have its length.
     /// The output slices of the fused evaluation, and the rates $C_t$, $g$ beside them
     /// (read by the correction of [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected)).
     fn dynamics_outputs(&mut self) -> (crate::DynamicsTerms<'_>, (&[f64], &[f64])) {
@@ -342,6 +339,9 @@ impl Workspace {
         (terms, (&self.ct, &self.bias))
     }
 
+    /// The model passed has the description this workspace was made for (same
+    /// `Info`, or one with the same name and shapes), so that its functions write
+    /// buffers of the sizes reserved here; `q` (and `qd`) have its length.
     fn check_model<M: Mechanism + ?Sized>(
         &self,
         mech: &M,
@@ -412,6 +412,40 @@ impl Workspace {
         if self.info.nh() > 0 {
             mech.holonomic(t, q, &mut self.c);
             check_finite(Quantity::Constraints, t, &self.c)?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates $C(q,t)$ and the pattern values of $C_q$ and $G$, $C$ and $C_q$ in one
+    /// call of the model's fused
+    /// [`holonomic_with_jacobian`](Mechanism::holonomic_with_jacobian) (the dense $J$
+    /// is not scattered).
+    pub fn eval_constraints_with_jacobian<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
+        let info = self.info;
+        if info.nh() > 0 {
+            mech.holonomic_with_jacobian(t, q, &mut self.c, &mut self.cq_values);
+            check_finite(Quantity::Constraints, t, &self.c)?;
+            check_finite_pattern(
+                Quantity::HolonomicJacobian,
+                t,
+                info.holonomic_pattern,
+                &self.cq_values,
+            )?;
+        }
+        if info.nnh() > 0 {
+            mech.nonholonomic_matrix(t, q, &mut self.g_values);
+            check_finite_pattern(
+                Quantity::NonholonomicMatrix,
+                t,
+                info.nonholonomic_pattern,
+                &self.g_values,
+            )?;
         }
         Ok(())
     }

@@ -91,6 +91,9 @@ impl<M: Mechanism, F: Fn(f64, &[f64], &[f64], &mut [f64])> Mechanism for Forced<
     fn holonomic_jacobian(&self, t: f64, q: &[f64], out: &mut [f64]) {
         self.model.holonomic_jacobian(t, q, out);
     }
+    fn holonomic_with_jacobian(&self, t: f64, q: &[f64], c: &mut [f64], cq: &mut [f64]) {
+        self.model.holonomic_with_jacobian(t, q, c, cq);
+    }
     fn holonomic_rate(&self, t: f64, q: &[f64], out: &mut [f64]) {
         self.model.holonomic_rate(t, q, out);
     }

@@ -92,11 +92,9 @@ pub(crate) trait Form {
     fn recoverable(&self, e: &SimErrorKind) -> bool;
 }
 
-/// Copies $y = [q; \dot q]$ into the state of `p`.
+/// Copies $y = [q; \dot q]$ into the state of `p` ([`Point::set_state`]).
 fn copy_state<M: Mechanism + ?Sized>(p: &mut Point<'_, M>, y: &[f64]) {
-    let n = p.q.len();
-    p.q.copy_from_slice(&y[..n]);
-    p.qd.copy_from_slice(&y[n..]);
+    p.set_state(y);
 }
 
 /// Coordinate partitioning in the local chart of the last accepted state

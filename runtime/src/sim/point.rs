@@ -51,6 +51,7 @@ impl Stamp {
 
     /// Whether the group holds values at `(t, q, qd)` (`qd` ignored for position-only
     /// groups).
+    #[inline]
     fn matches(&self, t: f64, q: &[f64], qd: &[f64]) -> bool {
         self.valid
             && self.t.to_bits() == t.to_bits()
@@ -59,6 +60,7 @@ impl Stamp {
     }
 
     /// Records that the group now holds values at `(t, q, qd)`.
+    #[inline]
     fn set(&mut self, t: f64, q: &[f64], qd: &[f64]) {
         self.valid = true;
         self.t = t;
@@ -70,11 +72,25 @@ impl Stamp {
 
     /// [`matches`](Self::matches); otherwise invalidates the stamp, for the caller to
     /// evaluate and [`set`](Self::set) it.
+    #[inline]
     fn check(&mut self, t: f64, q: &[f64], qd: &[f64]) -> bool {
         let same = self.matches(t, q, qd);
         self.valid &= same;
         same
     }
+}
+
+/// How often a [`Point`] evaluated the holonomic constraints and their Jacobian, and
+/// how: the fused evaluation computes both for little more than either.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct PositionEvaluations {
+    /// $C$ alone (`Mechanism::holonomic`).
+    pub constraints: u64,
+    /// $C_q$ and $G$ without $C$ (`Mechanism::holonomic_jacobian`,
+    /// `nonholonomic_matrix`; the dynamics terms are not counted).
+    pub jacobian: u64,
+    /// $C$ and $C_q$ in one call (`Mechanism::holonomic_with_jacobian`), $G$ beside.
+    pub fused: u64,
 }
 
 /// The current full state and the evaluations made at it.
@@ -118,6 +134,14 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     rates: Stamp,
     terms: Stamp,
     solved: Stamp,
+    /// Whether the next evaluation of $C$ at a new point also evaluates $C_q$ and $G$
+    /// (see [`constraints`](Self::constraints)): $J$ was asked for after $C$ at the
+    /// last point $C$ was evaluated at.
+    paired: bool,
+    /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
+    /// in one fused call (read by the tests).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub evaluations: PositionEvaluations,
     pub newton_iterations: u64,
     pub factorizations: u64,
     /// Constraints the augmented solve found redundant so far.
@@ -158,10 +182,23 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             rates: Stamp::new(n, false),
             terms: Stamp::new(n, true),
             solved: Stamp::new(n, true),
+            paired: false,
+            evaluations: PositionEvaluations::default(),
             newton_iterations: 0,
             factorizations: 0,
             redundant: Vec::new(),
         })
+    }
+
+    /// Sets the state to $y = [q; \dot q]$ (a state from the integrator). Whether $C$
+    /// comes with $J$ ([`constraints`](Self::constraints)) is learnt again from how the
+    /// new state is used: what was asked for at the last state says nothing about
+    /// the correction of a new one.
+    pub fn set_state(&mut self, y: &[f64]) {
+        let n = self.q.len();
+        self.q.copy_from_slice(&y[..n]);
+        self.qd.copy_from_slice(&y[n..]);
+        self.paired = false;
     }
 
     /// Forgets every evaluation (after the workspace was used directly, as assembly
@@ -245,18 +282,84 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $C$ at the current $(t, q)$.
+    ///
+    /// Evaluated with $C_q$ and $G$ by the model's fused
+    /// [`holonomic_with_jacobian`](Mechanism::holonomic_with_jacobian) when $J$ is not
+    /// held at the point and was asked for after $C$ at the last point $C$ was
+    /// evaluated at: an iteration that reads both at each iterate (the chart's polish)
+    /// gets both from one call from its second iterate on, one that reads only $C$
+    /// from a state just set (the chart's correction, after
+    /// [`set_state`](Self::set_state)) evaluates $C$ alone. Callers that know they need
+    /// both call
+    /// [`constraints_with_jacobian`](Self::constraints_with_jacobian).
     pub fn constraints(&mut self, t: f64) -> Result<&[f64], EvalError> {
         if !self.constraints.check(t, &self.q, &[]) {
-            self.ws.eval_constraints(self.mech, t, &self.q)?;
-            self.constraints.set(t, &self.q, &[]);
+            if self.paired && !self.jacobian.check(t, &self.q, &[]) {
+                self.eval_fused(t)?;
+            } else {
+                self.ws.eval_constraints(self.mech, t, &self.q)?;
+                self.evaluations.constraints += 1;
+                self.constraints.set(t, &self.q, &[]);
+            }
+            self.paired = false;
         }
         Ok(self.ws.constraints())
     }
 
+    /// $C$ and the pattern values of $C_q$ and $G$ at the current $(t, q)$, by one
+    /// fused evaluation when neither is held.
+    pub fn constraints_with_jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
+        let held = (
+            self.constraints.check(t, &self.q, &[]),
+            self.jacobian.check(t, &self.q, &[]),
+        );
+        match held {
+            (true, true) => {}
+            (false, false) => self.eval_fused(t)?,
+            (false, true) => {
+                self.ws.eval_constraints(self.mech, t, &self.q)?;
+                self.evaluations.constraints += 1;
+                self.constraints.set(t, &self.q, &[]);
+            }
+            (true, false) => self.jacobian_values(t)?,
+        }
+        self.paired = true;
+        Ok(())
+    }
+
+    /// $C$ and the dense $J$ at the current $(t, q)$ (see
+    /// [`constraints_with_jacobian_values`](Self::constraints_with_jacobian_values)),
+    /// read with [`Workspace::constraints`] and [`Workspace::jacobian`].
+    pub fn constraints_with_jacobian(&mut self, t: f64) -> Result<(), EvalError> {
+        self.constraints_with_jacobian_values(t)?;
+        self.dense_jacobian(t)?;
+        Ok(())
+    }
+
+    /// $C$, $C_q$ (one fused call) and $G$ at the current $(t, q)$, stamped.
+    fn eval_fused(&mut self, t: f64) -> Result<(), EvalError> {
+        self.ws
+            .eval_constraints_with_jacobian(self.mech, t, &self.q)?;
+        self.evaluations.fused += 1;
+        self.constraints.set(t, &self.q, &[]);
+        self.jacobian.set(t, &self.q, &[]);
+        Ok(())
+    }
+
+    /// Notes that $J$ is asked for: after $C$ at the same point, the next $C$ at a new
+    /// point comes with $J$ (see [`constraints`](Self::constraints)).
+    fn note_jacobian(&mut self, t: f64) {
+        if !self.paired && self.constraints.matches(t, &self.q, &[]) {
+            self.paired = true;
+        }
+    }
+
     /// The pattern values of $C_q$ and $G$ at the current $(t, q)$.
     fn jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
+        self.note_jacobian(t);
         if !self.jacobian.check(t, &self.q, &[]) {
             self.ws.eval_jacobian_values(self.mech, t, &self.q)?;
+            self.evaluations.jacobian += 1;
             self.jacobian.set(t, &self.q, &[]);
         }
         Ok(())
@@ -264,6 +367,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
 
     /// The dense $J$ at the current $(t, q)$.
     pub fn dense_jacobian(&mut self, t: f64) -> Result<&[f64], EvalError> {
+        self.note_jacobian(t);
         if !self.dense.check(t, &self.q, &[]) {
             self.jacobian_values(t)?;
             self.ws.scatter_jacobian();
@@ -296,7 +400,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// $(\lVert C\rVert_\infty, \lVert C_q\dot q + C_t\rVert_\infty,
     /// \lVert G\dot q + g\rVert_\infty)$ at the current state.
     pub fn violations(&mut self, t: f64) -> Result<(f64, f64, f64), EvalError> {
-        let c = inf_norm(self.constraints(t)?);
+        self.constraints_with_jacobian_values(t)?;
+        let c = inf_norm(self.ws.constraints());
         self.velocity_residuals(t)?;
         let mh = self.info.nh();
         Ok((c, inf_norm(&self.vel[..mh]), inf_norm(&self.vel[mh..])))
@@ -418,7 +523,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         shift: &mut [f64],
     ) -> Result<(), EvalError> {
         let mh = self.info.nh();
-        self.constraints(t)?;
+        self.constraints_with_jacobian_values(t)?;
         self.velocity_residuals(t)?;
         let c = self.ws.constraints();
         for (i, s) in shift.iter_mut().enumerate() {
@@ -523,8 +628,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             let mut iterations = 0;
             let mut previous = f64::INFINITY;
             loop {
-                let residual = inf_norm(self.constraints(t).map_err(eval)?);
-                self.dense_jacobian(t).map_err(eval)?;
+                self.constraints_with_jacobian(t).map_err(eval)?;
+                let residual = inf_norm(self.ws.constraints());
                 let size = scale::coordinate_size(&self.q);
                 let (c, jac) = (self.ws.constraints(), self.ws.jacobian());
                 // Met, or stagnant at the rounding floor (`scale::at_rounding_floor`).
@@ -625,7 +730,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// The holonomic constraints not met to the relative `tolerance` at the current
     /// $(t, q)$ (see [`crate::scale`]); empty when they cannot be evaluated.
     pub fn violated(&mut self, t: f64, tolerance: f64) -> Vec<&'static str> {
-        if self.constraints(t).is_err() || self.dense_jacobian(t).is_err() {
+        if self.constraints_with_jacobian(t).is_err() {
             return Vec::new();
         }
         let size = scale::coordinate_size(&self.q);
@@ -639,5 +744,104 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         )
         .map(|i| self.info.holonomic[i].name)
         .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DynamicsParams, KinematicsParams, Symbol};
+
+    /// A particle on the unit circle, $C = x^2 + y^2 - 1$, $C_q = [2x, 2y]$.
+    struct Circle;
+
+    static INFO: Info = Info {
+        name: "circle",
+        coordinates: &[Symbol { name: "x", doc: "" }, Symbol { name: "y", doc: "" }],
+        holonomic: &[Symbol {
+            name: "radius",
+            doc: "",
+        }],
+        mass_pattern: &[(0, 0), (1, 1)],
+        holonomic_pattern: &[(0, 0), (0, 1)],
+        ..Info::EMPTY
+    };
+
+    impl Mechanism for Circle {
+        fn info(&self) -> &'static Info {
+            &INFO
+        }
+        fn parameter(&self, _: usize) -> f64 {
+            unreachable!("no parameters")
+        }
+        fn set_parameter(&mut self, _: usize, _: f64) {
+            unreachable!("no parameters")
+        }
+        fn mass_matrix(&self, _: f64, _: &[f64], out: &mut [f64]) {
+            out.fill(1.0);
+        }
+        fn forces(&self, _: f64, _: &[f64], _: &[f64], out: &mut [f64]) {
+            out.fill(0.0);
+        }
+        fn holonomic(&self, _: f64, q: &[f64], out: &mut [f64]) {
+            out[0] = q[0] * q[0] + q[1] * q[1] - 1.0;
+        }
+        fn holonomic_jacobian(&self, _: f64, q: &[f64], out: &mut [f64]) {
+            out[0] = 2.0 * q[0];
+            out[1] = 2.0 * q[1];
+        }
+        fn kinetic_energy(&self, _: f64, _: &[f64], qd: &[f64]) -> f64 {
+            0.5 * (qd[0] * qd[0] + qd[1] * qd[1])
+        }
+    }
+
+    fn counts(p: &Point<'_, Circle>) -> (u64, u64, u64) {
+        let e = p.evaluations;
+        (e.constraints, e.jacobian, e.fused)
+    }
+
+    /// $C$ comes with $J$ exactly when $J$ was asked for after $C$ at the last point
+    /// since the state was set: an iteration reading both at each iterate (the chart's
+    /// polish) evaluates them in one call from its second iterate on, one reading $C$
+    /// only (the chart's correction) never evaluates $J$; the values are those of the
+    /// separate functions.
+    #[test]
+    fn constraints_come_with_the_jacobian_when_both_were_read() {
+        let mech = Circle;
+        let mut p = Point::new(
+            &mech,
+            DynamicsParams::default(),
+            KinematicsParams::default(),
+        )
+        .expect("a point");
+        // Reading C only, at three iterates.
+        p.set_state(&[1.2, 0.1, 0.0, 0.0]);
+        for k in 0..3 {
+            p.q[1] = 0.1 * f64::from(k);
+            p.constraints(0.0).expect("C");
+        }
+        assert_eq!(counts(&p), (3, 0, 0));
+        // C, then J, at each iterate: separate at the first, fused from the second.
+        for k in 0..3 {
+            p.q[0] = 1.0 + 0.01 * f64::from(k);
+            let c = p.constraints(0.0).expect("C")[0];
+            let j = p.dense_jacobian(0.0).expect("J").to_vec();
+            let (x, y) = (p.q[0], p.q[1]);
+            assert_eq!(c, x * x + y * y - 1.0);
+            assert_eq!(j, [2.0 * x, 2.0 * y]);
+        }
+        assert_eq!(counts(&p), (4, 1, 2));
+        // A new state from the integrator: C alone again until J is asked for.
+        p.set_state(&[0.9, 0.3, 0.0, 0.0]);
+        p.constraints(0.0).expect("C");
+        assert_eq!(counts(&p), (5, 1, 2));
+        // Both asked for together: one fused call, then hits.
+        p.q[0] = 0.95;
+        p.constraints_with_jacobian(0.0).expect("C and J");
+        p.violations(0.0).expect("violations");
+        p.constraints(0.0).expect("C");
+        p.dense_jacobian(0.0).expect("J");
+        assert_eq!(counts(&p), (5, 1, 3));
+        assert_eq!(p.ws.constraints()[0], 0.95 * 0.95 + 0.3 * 0.3 - 1.0);
     }
 }

@@ -358,3 +358,84 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
         }
     }
 }
+
+/// `holonomic_with_jacobian` (one schedule for `C` and `C_q`, generated for every model
+/// with holonomic constraints) writes what `holonomic` and `holonomic_jacobian` write,
+/// on seeded random states of every built-in model with holonomic constraints: the
+/// same expressions with their temporaries shared, so equal up to rounding (a sine
+/// alone and a sine of `sin_cos` may differ in the last bit), within
+/// 10⁻¹⁴ (1 + ‖q‖∞) ‖C_q‖∞ for `C` and 10⁻¹⁴ ‖C_q‖∞ for `C_q`; most models agree to
+/// the bit. The separate functions are checked against finite differences in
+/// `bodies/joints.rs` and `flex/crank.rs` (`MechanismExt::check_derivatives`); the
+/// fused `C_q` is checked here against central differences of the fused `C` too (step
+/// `1e-6 (1 + |q_j|)`, within 10⁻⁵ ‖C_q‖∞, the tolerance of those tests).
+#[test]
+fn constraints_with_jacobian_equal_the_separate_functions() {
+    let (mut checked, mut bitwise) = (0, 0);
+    for (k, entry) in pfaff_models::all().iter().enumerate() {
+        let model = (entry.make)();
+        let info = model.info();
+        let (n, mh) = (info.nq(), info.nh());
+        if mh == 0 {
+            continue;
+        }
+        let name = entry.name;
+        let pattern = info.holonomic_pattern;
+        for (j, (q, _)) in states(model.as_ref(), 5, 40 + k as u64)
+            .into_iter()
+            .enumerate()
+        {
+            #[allow(clippy::cast_precision_loss)]
+            let t = 0.1 * j as f64;
+            let (mut c, mut cq) = (vec![f64::NAN; mh], vec![f64::NAN; pattern.len()]);
+            model.holonomic_with_jacobian(t, &q, &mut c, &mut cq);
+            let (mut c_sep, mut cq_sep) = (vec![0.0; mh], vec![0.0; pattern.len()]);
+            model.holonomic(t, &q, &mut c_sep);
+            model.holonomic_jacobian(t, &q, &mut cq_sep);
+            let size = cq.iter().fold(1.0_f64, |s, v| s.max(v.abs()));
+            let reach = 1.0 + q.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+            let off = |a: &[f64], b: &[f64]| {
+                a.iter()
+                    .zip(b)
+                    .fold(0.0_f64, |e, (x, y)| e.max((x - y).abs()))
+            };
+            let (ec, ecq) = (off(&c, &c_sep), off(&cq, &cq_sep));
+            assert!(ec <= 1e-14 * reach * size, "{name}: C off by {ec:e}");
+            assert!(ecq <= 1e-14 * size, "{name}: C_q off by {ecq:e}");
+            bitwise += usize::from(c == c_sep && cq == cq_sep);
+            // C_q against central differences of the fused C.
+            let mut dense = vec![0.0; mh * n];
+            for (&(r, col), v) in pattern.iter().zip(&cq) {
+                dense[r as usize * n + col as usize] = *v;
+            }
+            let (mut cp, mut cm, mut scratch) = (vec![0.0; mh], vec![0.0; mh], cq.clone());
+            let mut qh = q.clone();
+            for col in 0..n {
+                let h = 1e-6 * (1.0 + q[col].abs());
+                qh[col] = q[col] + h;
+                model.holonomic_with_jacobian(t, &qh, &mut cp, &mut scratch);
+                qh[col] = q[col] - h;
+                model.holonomic_with_jacobian(t, &qh, &mut cm, &mut scratch);
+                qh[col] = q[col];
+                for r in 0..mh {
+                    let fd = (cp[r] - cm[r]) / (2.0 * h);
+                    let e = (fd - dense[r * n + col]).abs();
+                    assert!(
+                        e <= 1e-5 * size,
+                        "{name}: C_q[{r}][{col}] = {} against {fd} by differences",
+                        dense[r * n + col]
+                    );
+                }
+            }
+        }
+        checked += 1;
+    }
+    assert!(
+        checked >= 10,
+        "only {checked} models with holonomic constraints"
+    );
+    eprintln!(
+        "{checked} models, {bitwise} of {} states equal to the bit",
+        5 * checked
+    );
+}

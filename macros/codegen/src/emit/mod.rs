@@ -39,6 +39,9 @@ struct ModelNames {
     input_prefix: String,
     /// The local array of temporaries of long functions.
     temps: String,
+    /// The arguments of `holonomic_with_jacobian` receiving `C` and `C_q`.
+    out_c: String,
+    out_cq: String,
     /// Per data slot: its field name, the prefix of its entries' names, its offset and
     /// length in the flat data.
     data: Vec<(Ident, String, usize, usize)>,
@@ -92,6 +95,13 @@ impl ModelNames {
         while declared.contains(&inputs) {
             inputs.push('_');
         }
+        let [out_c, out_cq] = ["c", "cq"].map(|base| {
+            let mut name = String::from(base);
+            while declared.contains(&name) {
+                name.push('_');
+            }
+            name
+        });
         let mut input_prefix = format!("{inputs}_");
         while declared.iter().any(|n| {
             n.strip_prefix(input_prefix.as_str())
@@ -123,6 +133,8 @@ impl ModelNames {
             inputs,
             input_prefix,
             temps,
+            out_c,
+            out_cq,
         }
     }
 }
@@ -470,6 +482,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
             &entries(&d.cq),
             false,
         ));
+        fns.extend(holonomic_with_jacobian(g, &names, d));
         if any_nonzero(g, &d.ct) {
             fns.extend(vector_fn(g, &names, "holonomic_rate", &d.ct, false));
         }
@@ -900,6 +913,38 @@ fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
         fn dynamics_terms(
             &self, #t: f64, #q: &[f64], #qd: &[f64], out: ::pfaff::__private::DynamicsTerms<'_>,
         ) {
+            #code
+        }
+    }
+}
+
+/// `holonomic_with_jacobian`: `C` and the pattern values of `C_q` in one schedule, so
+/// that the sines and cosines of the angles and the lengths they share are computed
+/// once (the position projections and the monitors need both at one point).
+fn holonomic_with_jacobian(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
+    let nc = d.c.len();
+    let mut roots = d.c.clone();
+    roots.extend(entries(&d.cq));
+    let c = Ident::new(&names.out_c, Span::call_site());
+    let cq = Ident::new(&names.out_cq, Span::call_site());
+    let (code, prog) = body(g, names, &roots, |k, ts| {
+        if k < nc {
+            let k = Literal::usize_unsuffixed(k);
+            quote!(#c[#k] = #ts;)
+        } else {
+            let k = Literal::usize_unsuffixed(k - nc);
+            quote!(#cq[#k] = #ts;)
+        }
+    });
+    let t = arg(&prog, "t", |v| *v == Var::Time);
+    let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
+    let cq = if d.cq.is_empty() {
+        format_ident!("_{}", cq)
+    } else {
+        cq
+    };
+    quote! {
+        fn holonomic_with_jacobian(&self, #t: f64, #q: &[f64], #c: &mut [f64], #cq: &mut [f64]) {
             #code
         }
     }
