@@ -329,6 +329,7 @@ impl Workspace {
     fn dynamics_outputs(&mut self) -> (crate::DynamicsTerms<'_>, (&[f64], &[f64])) {
         let (gamma_h, gamma_nh) = self.gamma.split_at_mut(self.info.nh());
         let terms = crate::DynamicsTerms {
+            holonomic: &mut self.c,
             mass: &mut self.mass_values,
             forces: &mut self.forces,
             holonomic_jacobian: &mut self.cq_values,

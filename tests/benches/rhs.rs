@@ -89,6 +89,7 @@ fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
+                    holonomic: &mut constraints,
                     mass: &mut mass,
                     forces: &mut forces,
                     holonomic_jacobian: &mut cq,
@@ -118,6 +119,7 @@ fn generated_solve(
     let mut cq = vec![0.0; info.holonomic_pattern.len()];
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut x = vec![0.0; n + mh + mnh];
+    let mut constraints = vec![0.0; mh];
     // Above the generator's budget (`chain100`) there is no generated solve: its
     // formulations take the sparse LU, measured below.
     if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable {
@@ -133,6 +135,7 @@ fn generated_solve(
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
+                    holonomic: &mut constraints,
                     mass: &mut mass,
                     forces,
                     holonomic_jacobian: &mut cq,

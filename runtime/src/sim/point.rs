@@ -442,17 +442,29 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
-    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too).
+    /// model's fused evaluation (which gives $C$, $C_q$ and $G$ to the position groups
+    /// too).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms.check(t, &self.q, &self.qd) {
             self.jacobian.valid = false;
+            self.constraints.valid = false;
             self.ws
                 .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
                 .map_err(SimErrorKind::from_eval)?;
             self.terms.set(t, &self.q, &self.qd);
             self.jacobian.set(t, &self.q, &[]);
+            self.stamp_terms_constraints(t);
         }
         Ok(())
+    }
+
+    /// Stamps the $C$ the dynamics terms wrote, when it is finite (a non-finite one is
+    /// left for [`constraints`](Self::constraints) to evaluate and report, as before
+    /// the terms carried it).
+    fn stamp_terms_constraints(&mut self, t: f64) {
+        if self.ws.constraints().iter().all(|c| c.is_finite()) {
+            self.constraints.set(t, &self.q, &[]);
+        }
     }
 
     /// The velocities corrected by `correct(cq, g, ct, bias, qd)` with the pattern values
@@ -471,11 +483,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.rates.set(t, &self.q, &[]);
         }
         self.jacobian.valid = false;
+        self.constraints.valid = false;
         self.terms.valid = false;
         self.ws
             .eval_dynamics_terms_corrected(self.mech, t, &self.q, &mut self.qd, correct)?;
         self.terms.set(t, &self.q, &self.qd);
         self.jacobian.set(t, &self.q, &[]);
+        self.stamp_terms_constraints(t);
         Ok(())
     }
 

@@ -53,11 +53,13 @@ fn multiplier_scale(model: &dyn Mechanism, q: &[f64], qd: &[f64]) -> f64 {
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut gamma = vec![0.0; mh + mnh];
     let (gh, gnh) = gamma.split_at_mut(mh);
+    let mut c = vec![0.0; mh];
     model.dynamics_terms(
         0.3,
         q,
         qd,
         DynamicsTerms {
+            holonomic: &mut c,
             mass: &mut mass,
             forces: &mut forces,
             holonomic_jacobian: &mut cq,
@@ -197,11 +199,13 @@ fn a_massless_coordinate_takes_the_general_path() {
         let mut cq = vec![0.0; info.holonomic_pattern.len()];
         let mut b = vec![0.0; n + mh];
         let (forces, gamma) = b.split_at_mut(n);
+        let mut c = vec![0.0; mh];
         model.dynamics_terms(
             0.3,
             &q,
             &qd,
             DynamicsTerms {
+                holonomic: &mut c,
                 mass: &mut mass,
                 forces,
                 holonomic_jacobian: &mut cq,
@@ -265,11 +269,13 @@ fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
     let mut gh = vec![0.0; mh];
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut gnh = vec![0.0; mnh];
+    let mut c = vec![0.0; mh];
     model.dynamics_terms(
         t,
         q,
         qd,
         DynamicsTerms {
+            holonomic: &mut c,
             mass: &mut mass,
             forces: &mut forces,
             holonomic_jacobian: &mut cq,
@@ -278,7 +284,7 @@ fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
             nonholonomic_gamma: &mut gnh,
         },
     );
-    [mass, forces, cq, gh, g, gnh].concat()
+    [c, mass, forces, cq, gh, g, gnh].concat()
 }
 
 /// `dynamics_terms_corrected` (generated for models with constraint rows, the trait's
@@ -317,6 +323,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
             let mut gh = vec![0.0; mh];
             let mut g_out = vec![0.0; g.len()];
             let mut gnh = vec![0.0; mnh];
+            let mut c_out = vec![0.0; mh];
             let mut corrected = qd.clone();
             let mut seen = None;
             model.dynamics_terms_corrected(
@@ -324,6 +331,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
                 &q,
                 &mut corrected,
                 DynamicsTerms {
+                    holonomic: &mut c_out,
                     mass: &mut out,
                     forces: &mut forces,
                     holonomic_jacobian: &mut cq_out,
@@ -348,7 +356,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
             assert!(relative(&gm, &g, 1.0) <= 1e-14, "{name}: G handed over");
             assert_ne!(corrected, qd, "{name}: the velocities were changed");
             let expected = terms(model.as_ref(), t, &q, &corrected);
-            let got = [out, forces, cq_out, gh, g_out, gnh].concat();
+            let got = [c_out, out, forces, cq_out, gh, g_out, gnh].concat();
             let scale = expected.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
             let e = relative(&got, &expected, scale);
             assert!(

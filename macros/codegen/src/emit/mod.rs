@@ -203,7 +203,8 @@ fn reads_data_inline(prog: &Program) -> bool {
 /// The outputs of `dynamics_terms` in its order, as roots of one schedule and the
 /// `(field, index)` of `DynamicsTerms` each root is stored in.
 fn dynamics_roots(d: &Derived) -> (Vec<ExprId>, Vec<(Ident, usize)>) {
-    let parts: [(&str, Vec<ExprId>); 6] = [
+    let parts: [(&str, Vec<ExprId>); 7] = [
+        ("holonomic", d.c.clone()),
         ("mass", entries(&d.mass)),
         ("forces", d.forces.clone()),
         ("holonomic_jacobian", entries(&d.cq)),
@@ -897,8 +898,8 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
     }
 }
 
-/// `dynamics_terms`: `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh` in one schedule, so that what
-/// they share is computed once.
+/// `dynamics_terms`: `C`, `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh` in one schedule, so that
+/// what they share is computed once.
 fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
     let (roots, slots) = dynamics_roots(d);
     let (code, prog) = body(g, names, &roots, |k, ts| {
