@@ -390,6 +390,17 @@ impl Workspace {
                 &self.cq_values,
             )?;
         }
+        self.eval_nonholonomic_matrix(mech, t, q)
+    }
+
+    /// Evaluates the pattern values of $G$ (nothing without non-holonomic rows).
+    fn eval_nonholonomic_matrix<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), EvalError> {
+        let info = self.info;
         if info.nnh() > 0 {
             mech.nonholonomic_matrix(t, q, &mut self.g_values);
             check_finite_pattern(
@@ -439,16 +450,7 @@ impl Workspace {
                 &self.cq_values,
             )?;
         }
-        if info.nnh() > 0 {
-            mech.nonholonomic_matrix(t, q, &mut self.g_values);
-            check_finite_pattern(
-                Quantity::NonholonomicMatrix,
-                t,
-                info.nonholonomic_pattern,
-                &self.g_values,
-            )?;
-        }
-        Ok(())
+        self.eval_nonholonomic_matrix(mech, t, q)
     }
 
     /// Evaluates $C_t$ and $g$.
