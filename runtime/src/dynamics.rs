@@ -51,8 +51,8 @@ use crate::linalg::inf_norm;
 use crate::linalg::small::SmallLu;
 use crate::linalg::sparse::SparseKkt;
 use crate::workspace::{
-    all_finite, check_finite, check_len, check_same_model, check_state, scatter_row_major, EvalError, Quantity,
-    Workspace,
+    all_finite, check_finite, check_len, check_same_model, check_state, scatter_row_major,
+    EvalError, Quantity, Workspace,
 };
 use crate::{AugmentedSolve, Info, Mechanism};
 

@@ -170,16 +170,7 @@ impl Contacts {
         let (qdd, lambda) = p.solution.split_at_mut(p.q.len());
         let (mech, q, qd) = (p.mech, &p.q, &p.qd);
         self.solver
-            .rest_correction(
-                mech,
-                t,
-                q,
-                qd,
-                qdd,
-                lambda,
-                &self.resting,
-                &mut self.nu,
-            )
+            .rest_correction(mech, t, q, qd, qdd, lambda, &self.resting, &mut self.nu)
             .map_err(SimErrorKind::Impact)
     }
 

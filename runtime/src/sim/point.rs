@@ -59,25 +59,18 @@ impl Versions {
     }
 
     /// The versions `(position, state)` of `(t, q, qd)`: those of the last state seen
-    /// when it is the same (`t` bitwise, `q` and `qd` by value), new ones otherwise.
-    /// Compares and copies in one pass without branches.
+    /// when it is the same (`t` bitwise, `q` and `qd` by value), new ones otherwise
+    /// (the state then copied).
     #[inline]
     fn sync(&mut self, t: f64, q: &[f64], qd: &[f64]) -> (u64, u64) {
-        let mut same_position = self.t.to_bits() == t.to_bits();
-        self.t = t;
-        for (s, &x) in self.q.iter_mut().zip(q) {
-            same_position &= *s == x;
-            *s = x;
-        }
-        let mut same_velocities = true;
-        for (s, &x) in self.qd.iter_mut().zip(qd) {
-            same_velocities &= *s == x;
-            *s = x;
-        }
-        if !same_position {
+        if self.t.to_bits() != t.to_bits() || self.q != q {
+            self.t = t;
+            self.q.copy_from_slice(q);
+            self.qd.copy_from_slice(qd);
             self.position += 1;
             self.state += 1;
-        } else if !same_velocities {
+        } else if self.qd != qd {
+            self.qd.copy_from_slice(qd);
             self.state += 1;
         }
         (self.position, self.state)
@@ -451,7 +444,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.solved == state {
             return Ok(());
         }
-        self.dynamics_terms(t)?;
+        self.dynamics_terms_at(t, (position, state))?;
         self.factorizations += 1;
         let stats = self
             .dynamics
@@ -474,7 +467,18 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// model's fused evaluation (which gives $C$, $C_q$ and $G$ to the position groups
     /// too).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        let (position, state) = self.versions(t);
+        let versions = self.versions(t);
+        self.dynamics_terms_at(t, versions)
+    }
+
+    /// [`dynamics_terms`](Self::dynamics_terms) at the current state, of versions
+    /// `(position, state)`.
+    #[inline]
+    fn dynamics_terms_at(
+        &mut self,
+        t: f64,
+        (position, state): (Stamp, Stamp),
+    ) -> Result<(), SimErrorKind> {
         if self.terms != state {
             self.jacobian = 0;
             self.constraints = 0;
