@@ -553,7 +553,10 @@ impl Plan {
                     // In a multiplier's column the coordinates' terms add (S), the
                     // multipliers' subtract.
                     let negative = !multiplier || self.order[j] >= n;
-                    items.push(Choice::of(negative, term(i, j, (&w_at, &l_at, &d_at, &r_at))));
+                    items.push(Choice::of(
+                        negative,
+                        term(i, j, (&w_at, &l_at, &d_at, &r_at)),
+                    ));
                 }
                 let w = Choice::sum(items);
                 w_at[e] = w.ready;
@@ -567,9 +570,7 @@ impl Plan {
         }
         // The back substitution, from the last position: s_k = z_k − Σ l_ik x_i, with
         // s = −λ in the multipliers (x_i = −s_i there).
-        let s_op = |k: usize, s_at: &[u32]| {
-            Operand::new(name("s", k).into_token_stream(), s_at[k])
-        };
+        let s_op = |k: usize, s_at: &[u32]| Operand::new(name("s", k).into_token_stream(), s_at[k]);
         let z_op = |k: usize| Operand::new(name("z", k).into_token_stream(), z_at[k]);
         for k in (0..dim).rev() {
             let mut items = vec![(false, z_op(k))];
@@ -793,9 +794,13 @@ impl Operand {
         assert!(!pool.is_empty(), "a sum of something");
         while pool.len() > 1 {
             // The two earliest (the first of equals: a deterministic tree).
-            let first = (0..pool.len()).min_by_key(|&i| pool[i].1.ready).expect("two");
+            let first = (0..pool.len())
+                .min_by_key(|&i| pool[i].1.ready)
+                .expect("two");
             let (na, a) = pool.remove(first);
-            let second = (0..pool.len()).min_by_key(|&i| pool[i].1.ready).expect("one");
+            let second = (0..pool.len())
+                .min_by_key(|&i| pool[i].1.ready)
+                .expect("one");
             let (nb, b) = pool.remove(second);
             let ready = a.ready.max(b.ready) + ADD;
             let paren = |o: &Operand| {
