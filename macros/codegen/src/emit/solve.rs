@@ -312,7 +312,7 @@ impl Plan {
     /// $(w_{ij} w_{kj}) r_j$ when that is ready earlier (the product of the `w` waits
     /// for no division), the forward substitution is folded into the factorization
     /// (`y`, computed with the rows of $L$ as they appear), and when it is cheap enough
-    /// (at most half the operations of the rest, see [`Plan::inverse_operations`]) the
+    /// (it adds at most half the operations of the rest, `Plan::inverse_operations`) the
     /// unit triangle of the multipliers' block is inverted alongside the factorization
     /// (its rows wait for no division), so that the multipliers are independent dot
     /// products after the last pivot instead of a chain of `m` substitutions.
