@@ -19,7 +19,7 @@ use super::error::{SimErrorKind, SingularMatrix};
 use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
 use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::inf_norm;
-use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::linalg::small::{gram_cholesky_planned, GramPlan, SmallCholesky};
 use crate::scale;
 use crate::workspace::{all_finite, EvalError, Workspace};
 use crate::{Error, Info, Mechanism, NewtonParams};
@@ -63,18 +63,25 @@ impl Versions {
     /// (the state then copied).
     #[inline]
     fn sync(&mut self, t: f64, q: &[f64], qd: &[f64]) -> (u64, u64) {
-        if self.t.to_bits() != t.to_bits() || self.q != q {
+        if self.t.to_bits() != t.to_bits() || !same(&self.q, q) {
             self.t = t;
             self.q.copy_from_slice(q);
             self.qd.copy_from_slice(qd);
             self.position += 1;
             self.state += 1;
-        } else if self.qd != qd {
+        } else if !same(&self.qd, qd) {
             self.qd.copy_from_slice(qd);
             self.state += 1;
         }
         (self.position, self.state)
     }
+}
+
+/// Whether `a` and `b` are equal entry by entry (by value, as `==`), in one pass without
+/// branches (vectorized).
+#[inline]
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.iter().zip(b).fold(true, |s, (x, y)| s & (x == y))
 }
 
 /// The version of the state a group of evaluations holds values at (0: none).
@@ -117,6 +124,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// whose projected rows are all holonomic (see [`Point::project`]).
     position_factor: bool,
     lu_v: SmallCholesky,
+    /// The products of the Gram matrices of `lu_h` (the holonomic rows of `rows`) and
+    /// `lu_v` (all of `rows`) the sparsity of $J$ leaves (see [`GramPlan`]).
+    gram_h: GramPlan,
+    gram_v: GramPlan,
     /// Scratch of a velocity update.
     dx: Vec<f64>,
     /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
@@ -159,7 +170,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     ) -> Result<Self, Error> {
         let info = mech.info();
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
-        Ok(Self {
+        let mut point = Self {
             mech,
             info,
             ws: Workspace::new(info)?,
@@ -174,6 +185,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             lu_h: SmallCholesky::new(mh),
             position_factor: false,
             lu_v: SmallCholesky::new(m),
+            gram_h: GramPlan::default(),
+            gram_v: GramPlan::default(),
             dx: vec![0.0; n],
             mass: SmallCholesky::new(0),
             rows: (0..m).collect(),
@@ -190,7 +203,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             redundant: Vec::new(),
-        })
+        };
+        point.plan_grams();
+        Ok(point)
     }
 
     /// Sets the state to $y = [q; \dot q]$ (a state from the integrator). Whether $C$
@@ -261,6 +276,24 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.lu_h = SmallCholesky::new(self.rows_h);
             self.lu_v = SmallCholesky::new(self.rows.len());
         }
+        self.plan_grams();
+    }
+
+    /// The plans of the projections' Gram matrices for the current `rows`, from the
+    /// patterns of $C_q$ and $G$ (allocates).
+    fn plan_grams(&mut self) {
+        let info = self.info;
+        let (n, mh) = (info.nq(), info.nh());
+        let mut nonzero = vec![false; (mh + info.nnh()) * n];
+        for &(r, c) in info.holonomic_pattern {
+            nonzero[r as usize * n + c as usize] = true;
+        }
+        for &(r, c) in info.nonholonomic_pattern {
+            nonzero[(mh + r as usize) * n + c as usize] = true;
+        }
+        let nonzero = |i: usize, j: usize| nonzero[i * n + j];
+        self.gram_h = GramPlan::new(&self.rows[..self.rows_h], n, nonzero);
+        self.gram_v = GramPlan::new(&self.rows, n, nonzero);
     }
 
     /// Fits the projections to the current partition, which may have dropped redundant
@@ -337,6 +370,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// fused evaluation when neither is held.
     pub fn constraints_with_jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
         let at = self.position(t);
+        self.constraints_with_jacobian_values_at(t, at)
+    }
+
+    /// [`constraints_with_jacobian_values`](Self::constraints_with_jacobian_values) at
+    /// the current $(t, q)$ of version `at`.
+    fn constraints_with_jacobian_values_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         match (self.constraints == at, self.jacobian == at) {
             (true, true) => {}
             (false, false) => self.eval_fused(t, at)?,
@@ -345,7 +384,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 self.evaluations.constraints += 1;
                 self.constraints = at;
             }
-            (true, false) => self.jacobian_values(t)?,
+            (true, false) => self.jacobian_values_at(t, at)?,
         }
         self.paired = true;
         Ok(())
@@ -355,9 +394,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// [`constraints_with_jacobian_values`](Self::constraints_with_jacobian_values)),
     /// read with [`Workspace::constraints`] and [`Workspace::jacobian`].
     pub fn constraints_with_jacobian(&mut self, t: f64) -> Result<(), EvalError> {
-        self.constraints_with_jacobian_values(t)?;
-        self.dense_jacobian(t)?;
-        Ok(())
+        let at = self.position(t);
+        self.constraints_with_jacobian_values_at(t, at)?;
+        self.dense_jacobian_at(t, at)
     }
 
     /// $C$, $C_q$ (one fused call) and $G$ at the current $(t, q)$, of version `at`,
@@ -373,16 +412,15 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
 
     /// Notes that $J$ is asked for: after $C$ at the same point, the next $C$ at a new
     /// point comes with $J$ (see [`constraints`](Self::constraints)).
-    fn note_jacobian(&mut self, t: f64) {
-        if !self.paired && self.constraints == self.position(t) {
+    fn note_jacobian(&mut self, at: Stamp) {
+        if !self.paired && self.constraints == at {
             self.paired = true;
         }
     }
 
-    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$.
-    fn jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
-        self.note_jacobian(t);
-        let at = self.position(t);
+    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$, of version `at`.
+    fn jacobian_values_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
+        self.note_jacobian(at);
         if self.jacobian != at {
             self.ws.eval_jacobian_values(self.mech, t, &self.q)?;
             self.evaluations.jacobian += 1;
@@ -393,14 +431,20 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
 
     /// The dense $J$ at the current $(t, q)$.
     pub fn dense_jacobian(&mut self, t: f64) -> Result<&[f64], EvalError> {
-        self.note_jacobian(t);
         let at = self.position(t);
+        self.dense_jacobian_at(t, at)?;
+        Ok(self.ws.jacobian())
+    }
+
+    /// [`dense_jacobian`](Self::dense_jacobian) at the current $(t, q)$ of version `at`.
+    fn dense_jacobian_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
+        self.note_jacobian(at);
         if self.dense != at {
-            self.jacobian_values(t)?;
+            self.jacobian_values_at(t, at)?;
             self.ws.scatter_jacobian();
             self.dense = at;
         }
-        Ok(self.ws.jacobian())
+        Ok(())
     }
 
     /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
@@ -408,8 +452,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
         let info = self.info;
         let mh = info.nh();
-        self.jacobian_values(t)?;
         let at = self.position(t);
+        self.jacobian_values_at(t, at)?;
         if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
@@ -705,8 +749,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                         constraints: self.violated(t, tol),
                     });
                 }
-                let rows = &self.rows[..self.rows_h];
-                let ratio = gram_cholesky(&mut self.lu_h, self.ws.jacobian(), rows, n);
+                let ratio = gram_cholesky_planned(&mut self.lu_h, self.ws.jacobian(), &self.gram_h);
                 if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
                     refitted = true;
                     continue;
@@ -751,11 +794,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let eval = SimErrorKind::from_eval;
         self.velocity_residuals(t).map_err(eval)?;
         self.dense_jacobian(t).map_err(eval)?;
-        let mut ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        let mut ratio = gram_cholesky_planned(&mut self.lu_v, self.ws.jacobian(), &self.gram_v);
         if (ratio.is_nan() || ratio <= REFIT_RATIO) && self.refit(t) {
             self.velocity_residuals(t).map_err(eval)?;
             self.dense_jacobian(t).map_err(eval)?;
-            ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+            ratio = gram_cholesky_planned(&mut self.lu_v, self.ws.jacobian(), &self.gram_v);
         }
         let rows = &self.rows[..];
         self.factorizations += 1;
