@@ -1,8 +1,8 @@
 //! One right-hand side of each formulation next to the generated functions it calls,
 //! in one run, per model:
 //!
-//! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C$,
-//!   $C_q$, $\gamma$, $G$) and one of `holonomic` ($C$): what every formulation
+//! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C_q$,
+//!   $\gamma$, $G$, without $C$) and one of `holonomic` ($C$): what every formulation
 //!   evaluates at least once per right-hand side (partitioning's correction evaluates
 //!   $C$ at the predicted positions, the terms at the corrected ones);
 //! - `generated+solve`: `dynamics_terms` and the model's generated `augmented_solve`
@@ -89,7 +89,7 @@ fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
-                    holonomic: &mut constraints,
+                    holonomic: None,
                     mass: &mut mass,
                     forces: &mut forces,
                     holonomic_jacobian: &mut cq,
@@ -118,7 +118,6 @@ fn generated_solve(
     let mut cq = vec![0.0; info.holonomic_pattern.len()];
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut x = vec![0.0; n + mh + mnh];
-    let mut constraints = vec![0.0; mh];
     // Above the generator's budget (`chain100`) there is no generated solve: its
     // formulations take the sparse LU, measured below.
     if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable {
@@ -134,7 +133,7 @@ fn generated_solve(
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
-                    holonomic: &mut constraints,
+                    holonomic: None,
                     mass: &mut mass,
                     forces,
                     holonomic_jacobian: &mut cq,

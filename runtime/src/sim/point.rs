@@ -442,17 +442,43 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
-    /// model's fused evaluation (which gives $C$, $C_q$ and $G$ to the position groups
-    /// too).
+    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too).
+    /// $C$ is not asked for: most callers do not read it at every point.
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms.check(t, &self.q, &self.qd) {
-            self.jacobian.valid = false;
+            self.eval_terms(t, false)?;
+        }
+        Ok(())
+    }
+
+    /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
+    /// the same call when neither is held (the generated code computes $C$ from the
+    /// sines it already has), [`constraints`](Self::constraints) when the terms are.
+    /// For callers that read $C$ at every point (Baumgarte's shift).
+    pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let held = self.constraints.check(t, &self.q, &[]);
+        if !self.terms.check(t, &self.q, &self.qd) {
+            self.eval_terms(t, !held)?;
+        } else if !held {
+            self.constraints(t).map_err(SimErrorKind::from_eval)?;
+        }
+        Ok(())
+    }
+
+    /// One call of the fused evaluation at the current state, asking for $C$ too when
+    /// `constraints`. Without it the workspace's $C$ is not written, so its stamp
+    /// stays true.
+    fn eval_terms(&mut self, t: f64, constraints: bool) -> Result<(), SimErrorKind> {
+        self.jacobian.valid = false;
+        if constraints {
             self.constraints.valid = false;
-            self.ws
-                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
-                .map_err(SimErrorKind::from_eval)?;
-            self.terms.set(t, &self.q, &self.qd);
-            self.jacobian.set(t, &self.q, &[]);
+        }
+        self.ws
+            .eval_dynamics_terms_with(self.mech, t, &self.q, &self.qd, constraints)
+            .map_err(SimErrorKind::from_eval)?;
+        self.terms.set(t, &self.q, &self.qd);
+        self.jacobian.set(t, &self.q, &[]);
+        if constraints {
             self.stamp_terms_constraints(t);
         }
         Ok(())
@@ -483,13 +509,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.rates.set(t, &self.q, &[]);
         }
         self.jacobian.valid = false;
-        self.constraints.valid = false;
         self.terms.valid = false;
         self.ws
             .eval_dynamics_terms_corrected(self.mech, t, &self.q, &mut self.qd, correct)?;
         self.terms.set(t, &self.q, &self.qd);
         self.jacobian.set(t, &self.q, &[]);
-        self.stamp_terms_constraints(t);
         Ok(())
     }
 
