@@ -573,6 +573,8 @@ impl Workspace {
     /// [`Mechanism::dynamics_terms_corrected`]: `correct(cq, g, ct, bias, qd)` may change
     /// `qd` between the position terms and the velocity terms; the rates $C_t$, $g$ it
     /// reads must have been evaluated at `(t, q)` ([`eval_rates`](Self::eval_rates)).
+    /// $C$ at `(t, q)` too when `constraints`, as in
+    /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with).
     // A callback with the slices it reads and the velocities it corrects.
     #[allow(clippy::type_complexity)]
     pub fn eval_dynamics_terms_corrected<M: Mechanism + ?Sized>(
@@ -581,10 +583,11 @@ impl Workspace {
         t: f64,
         q: &[f64],
         qd: &mut [f64],
+        constraints: bool,
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let (terms, (ct, bias)) = self.dynamics_outputs(false);
+        let (terms, (ct, bias)) = self.dynamics_outputs(constraints);
         mech.dynamics_terms_corrected(t, q, qd, terms, &mut |cq, g, qd| {
             correct(cq, g, ct, bias, qd);
         });

@@ -138,6 +138,13 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// (see [`constraints`](Self::constraints)): $J$ was asked for after $C$ at the
     /// last point $C$ was evaluated at.
     paired: bool,
+    /// Whether every evaluation of the dynamics terms asks for $C$ at the point too
+    /// (when not held): set for an integrator whose last evaluation of a step is at
+    /// the state the step keeps (Adams' final evaluation), where the position group
+    /// of the projections reads $C$ next, for a few operations on the sines the terms
+    /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
+    /// dynamics terms only where it is read").
+    pub constraints_with_terms: bool,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
     /// in one fused call (read by the tests).
     #[cfg_attr(not(test), allow(dead_code))]
@@ -187,6 +194,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             redundant: Vec::new(),
+            constraints_with_terms: false,
         })
     }
 
@@ -442,11 +450,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
-    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too).
-    /// $C$ is not asked for: most callers do not read it at every point.
+    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too,
+    /// and $C$ when [`constraints_with_terms`](Self::constraints_with_terms)).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms.check(t, &self.q, &self.qd) {
-            self.eval_terms(t, false)?;
+            let with_c = self.constraints_with_terms && !self.constraints.check(t, &self.q, &[]);
+            self.eval_terms(t, with_c)?;
         }
         Ok(())
     }
@@ -508,12 +517,25 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates.set(t, &self.q, &[]);
         }
+        let with_c = self.constraints_with_terms && !self.constraints.check(t, &self.q, &[]);
         self.jacobian.valid = false;
         self.terms.valid = false;
-        self.ws
-            .eval_dynamics_terms_corrected(self.mech, t, &self.q, &mut self.qd, correct)?;
+        if with_c {
+            self.constraints.valid = false;
+        }
+        self.ws.eval_dynamics_terms_corrected(
+            self.mech,
+            t,
+            &self.q,
+            &mut self.qd,
+            with_c,
+            correct,
+        )?;
         self.terms.set(t, &self.q, &self.qd);
         self.jacobian.set(t, &self.q, &[]);
+        if with_c {
+            self.stamp_terms_constraints(t);
+        }
         Ok(())
     }
 
@@ -881,5 +903,52 @@ mod tests {
         p.dense_jacobian(0.0).expect("J");
         assert_eq!(counts(&p), (5, 1, 3));
         assert_eq!(p.ws.constraints()[0], 0.95 * 0.95 + 0.3 * 0.3 - 1.0);
+    }
+
+    /// $C$ comes with the dynamics terms only when asked for, and is never stale: terms
+    /// evaluated without it leave the $C$ held at another point to be evaluated anew
+    /// where it is read; with [`Point::constraints_with_terms`] (and for Baumgarte's
+    /// [`Point::dynamics_terms_and_constraints`]) the terms' call writes it, and reading
+    /// it at the same point evaluates nothing more. Values against the closed form
+    /// $x^2 + y^2 - 1$.
+    #[test]
+    fn constraints_come_with_the_terms_only_when_asked_for() {
+        let mech = Circle;
+        let mut p = Point::new(
+            &mech,
+            DynamicsParams::default(),
+            KinematicsParams::default(),
+        )
+        .expect("a point");
+        let circle = |p: &Point<'_, Circle>| p.q[0] * p.q[0] + p.q[1] * p.q[1] - 1.0;
+        p.set_state(&[1.2, 0.1, 0.3, -0.2]);
+        p.constraints(0.0).expect("C");
+        assert_eq!(counts(&p), (1, 0, 0));
+        // Terms at a new point without C: C there is evaluated when read.
+        p.q[0] = 1.1;
+        p.dynamics_terms(0.0).expect("terms");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        // Asked for with every evaluation of the terms: read at no further cost.
+        p.constraints_with_terms = true;
+        p.q[1] = 0.2;
+        p.dynamics_terms(0.0).expect("terms");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        // Baumgarte's request, at a new point and then with the terms held.
+        p.constraints_with_terms = false;
+        p.q[0] = 1.05;
+        p.dynamics_terms_and_constraints(0.0).expect("terms and C");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        p.q[1] = 0.25;
+        p.dynamics_terms(0.0).expect("terms");
+        p.dynamics_terms_and_constraints(0.0).expect("C alone");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (3, 0, 0));
     }
 }
