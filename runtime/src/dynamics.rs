@@ -51,8 +51,8 @@ use crate::linalg::inf_norm;
 use crate::linalg::small::SmallLu;
 use crate::linalg::sparse::SparseKkt;
 use crate::workspace::{
-    check_finite, check_len, check_same_model, check_state, scatter_row_major, EvalError, Quantity,
-    Workspace,
+    all_finite, check_finite, check_len, check_same_model, check_state, scatter_row_major,
+    EvalError, Quantity, Workspace,
 };
 use crate::{AugmentedSolve, Info, Mechanism};
 
@@ -197,6 +197,9 @@ pub struct Dynamics {
     x: Vec<f64>,
     b: Vec<f64>,
     r: Vec<f64>,
+    /// $[\ddot q; \lambda]$ of [`accelerations`](Self::accelerations), before they
+    /// are handed out in the caller's two slices.
+    out: Vec<f64>,
     redundant: Vec<usize>,
     /// The split of the last redundant solve, tried first while it serves.
     split: Option<Split>,
@@ -308,6 +311,7 @@ impl Dynamics {
             x: vec![0.0; dim],
             b: vec![0.0; dim],
             r: vec![0.0; dim],
+            out: vec![0.0; dim],
             redundant: Vec::with_capacity(info.nh() + info.nnh()),
             split: None,
         })
@@ -376,32 +380,37 @@ impl Dynamics {
         check_len(Quantity::Accelerations, qdd, n)?;
         check_len(Quantity::Multipliers, lambda, m)?;
         ws.eval_dynamics_terms(mech, t, q, qd)?;
-        self.solve_evaluated(mech, ws, t, shift, qdd, lambda)
+        // The solution buffer leaves `self` for the call (a move of the vector, no
+        // allocation) and comes back whatever the outcome.
+        let mut out = std::mem::take(&mut self.out);
+        let stats = self.solve_evaluated(mech, ws, t, shift, &mut out);
+        if stats.is_ok() {
+            qdd.copy_from_slice(&out[..n]);
+            lambda.copy_from_slice(&out[n..]);
+        }
+        self.out = out;
+        stats
     }
 
     /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
-    /// $\gamma$ already evaluated in `ws` (lengths checked by the caller).
+    /// $\gamma$ already evaluated in `ws` (lengths checked by the caller), into
+    /// `out` $= [\ddot q; \lambda]$ (length $n + m$; its contents are unspecified
+    /// after an error). The model's generated solve works in `out` itself: the
+    /// right-hand side is written there and solved in place, with no copy in between.
     pub(crate) fn solve_evaluated<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
         ws: &mut Workspace,
         t: f64,
         shift: Option<&[f64]>,
-        qdd: &mut [f64],
-        lambda: &mut [f64],
+        out: &mut [f64],
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
-        let (n, m) = (info.nq(), info.nh() + info.nnh());
-        self.b[..n].copy_from_slice(&ws.forces);
-        self.b[n..].copy_from_slice(&ws.gamma);
-        if let Some(shift) = shift {
-            for (b, s) in self.b[n..].iter_mut().zip(shift) {
-                *b += s;
-            }
-        }
+        let m = info.nh() + info.nnh();
         self.redundant.clear();
 
         if let Some(split) = self.split.as_mut() {
+            right_hand_side(ws, shift, &mut self.b);
             scatter_jacobian(info, ws);
             let tol = self.params.redundant_tolerance;
             match split.solve(
@@ -419,7 +428,7 @@ impl Dynamics {
                         rank: split.rows_r.len(),
                         pivot_ratio: ratio,
                     };
-                    return self.finish(t, qdd, lambda, stats);
+                    return self.finish(t, out, stats);
                 }
                 // Not redundant there any more: from the full system.
                 Err(_) => self.split = None,
@@ -427,12 +436,10 @@ impl Dynamics {
         }
 
         if self.generated {
-            self.x.copy_from_slice(&self.b);
-            match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, &mut self.x) {
+            right_hand_side(ws, shift, out);
+            match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, out) {
                 // A non-finite result goes to the general path, which reports it.
-                AugmentedSolve::Solved if self.x.iter().all(|v| v.is_finite()) => {
-                    qdd.copy_from_slice(&self.x[..n]);
-                    lambda.copy_from_slice(&self.x[n..]);
+                AugmentedSolve::Solved if all_finite(out) => {
                     return Ok(AccelerationStats {
                         path: SolverPath::Generated,
                         rank: m,
@@ -443,6 +450,7 @@ impl Dynamics {
                 AugmentedSolve::Solved | AugmentedSolve::Declined => {}
             }
         }
+        right_hand_side(ws, shift, &mut self.b);
         let small = self.small.as_mut().and_then(|lu| {
             fill_small(lu, info, ws);
             let ratio = lu.factor().ratio();
@@ -493,22 +501,20 @@ impl Dynamics {
             Some(s) => s,
             None => self.solve_redundant(ws, t)?,
         };
-        self.finish(t, qdd, lambda, stats)
+        self.finish(t, out, stats)
     }
 
-    /// Checks the solution in `x` and hands it out.
+    /// Checks the solution in `x` and hands it out as `out` $= [\ddot q; \lambda]$.
     fn finish(
         &self,
         t: f64,
-        qdd: &mut [f64],
-        lambda: &mut [f64],
+        out: &mut [f64],
         stats: AccelerationStats,
     ) -> Result<AccelerationStats, DynamicsError> {
         let n = self.info.nq();
         check_finite(Quantity::Accelerations, t, &self.x[..n])?;
         check_finite(Quantity::Multipliers, t, &self.x[n..])?;
-        qdd.copy_from_slice(&self.x[..n]);
-        lambda.copy_from_slice(&self.x[n..]);
+        out.copy_from_slice(&self.x);
         Ok(stats)
     }
 
@@ -684,6 +690,19 @@ impl Split {
             out[n + d] = dot(&xt[k * r..(k + 1) * r], &self.y);
         }
         Ok(ratio)
+    }
+}
+
+/// Writes $[Q; \gamma + s]$ (`s` the shift, when given) from `ws` into `b`.
+#[inline]
+fn right_hand_side(ws: &Workspace, shift: Option<&[f64]>, b: &mut [f64]) {
+    let (q, gamma) = b.split_at_mut(ws.forces.len());
+    q.copy_from_slice(&ws.forces);
+    gamma.copy_from_slice(&ws.gamma);
+    if let Some(shift) = shift {
+        for (b, s) in gamma.iter_mut().zip(shift) {
+            *b += s;
+        }
     }
 }
 

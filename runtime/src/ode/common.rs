@@ -12,10 +12,11 @@ use super::system::OdeSystem;
 pub(crate) const UROUND: f64 = f64::EPSILON;
 
 /// Index of the first NaN or infinite entry. The common case, all finite, is one
-/// branch-free pass that vectorizes; the position is searched only after it fails.
+/// branch-free pass ([`all_finite`](crate::workspace::all_finite)); the position is
+/// searched only after it fails.
 #[inline]
 pub(crate) fn first_non_finite(x: &[f64]) -> Option<usize> {
-    if x.iter().fold(true, |all, v| all & v.is_finite()) {
+    if crate::workspace::all_finite(x) {
         return None;
     }
     x.iter().position(|v| !v.is_finite())

@@ -167,17 +167,10 @@ impl Contacts {
             return Ok(());
         }
         p.invalidate_solved();
+        let (qdd, lambda) = p.solution.split_at_mut(p.q.len());
+        let (mech, q, qd) = (p.mech, &p.q, &p.qd);
         self.solver
-            .rest_correction(
-                p.mech,
-                t,
-                &p.q,
-                &p.qd,
-                &mut p.qdd,
-                &mut p.lambda,
-                &self.resting,
-                &mut self.nu,
-            )
+            .rest_correction(mech, t, q, qd, qdd, lambda, &self.resting, &mut self.nu)
             .map_err(SimErrorKind::Impact)
     }
 
@@ -678,7 +671,7 @@ fn handle_in<M: Mechanism + ?Sized>(
         .normal_velocities(mech, t, &p.q, &p.qd, &mut c.vn)
         .map_err(eval)?;
     c.solver
-        .normal_accelerations(mech, t, &p.q, &p.qd, &p.qdd, &mut c.an)
+        .normal_accelerations(mech, t, &p.q, &p.qd, p.qdd(), &mut c.an)
         .map_err(eval)?;
     c.gaps_at(mech, t, &p.q)?;
     let eps = gap_tol(&p.q);

@@ -112,7 +112,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         let p = &self.sys.point;
         let energy = self.monitors.energy_final.filter(|_| p.info.conservative);
         self.traj
-            .push(t, &p.q, &p.qd, &p.lambda, v.0, v.1.max(v.2), energy);
+            .push(t, &p.q, &p.qd, p.lambda(), v.0, v.1.max(v.2), energy);
         Ok(())
     }
 

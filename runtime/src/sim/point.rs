@@ -6,19 +6,22 @@
 //! current state.
 //!
 //! Invariant: a quantity is evaluated at most once per point. Each group of generated
-//! functions is stamped with the $(t, q)$ (and $\dot q$ for the dynamics terms) it was
-//! evaluated at and reused while the state is unchanged (bitwise), so the velocity
-//! projection, the augmented solve, the monitors and the record of one state share one
-//! $C_q$; the stamps compare $n$ numbers, which costs far less than any evaluation.
+//! functions is stamped with the version of the $(t, q)$ (and $\dot q$ for the dynamics
+//! terms) it was evaluated at and reused while the state keeps that version, so the
+//! velocity projection, the augmented solve, the monitors and the record of one state
+//! share one $C_q$. A check compares the state with the last one seen ($t$ bitwise,
+//! $q$ and $\dot q$ by value, copying them in the same pass) and numbers it anew when it
+//! changed ([`Versions`]): $2n$ comparisons per check, one copy per new state, however
+//! many groups are evaluated at it.
 //! Nothing allocates after [`Point::new`] (except when building an error).
 
 use super::error::{SimErrorKind, SingularMatrix};
 use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
 use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::inf_norm;
-use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::linalg::small::{gram_cholesky_planned, GramPlan, SmallCholesky};
 use crate::scale;
-use crate::workspace::{EvalError, Workspace};
+use crate::workspace::{all_finite, EvalError, Workspace};
 use crate::{Error, Info, Mechanism, NewtonParams};
 
 /// Pivot ratio below which a projection matrix $J J^\mathsf{T}$ counts as singular.
@@ -30,55 +33,59 @@ pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
 /// Newton starts to stall long before the matrix is singular.
 pub(crate) const REFIT_RATIO: f64 = 1e-8;
 
-/// The point a group of evaluations was made at.
+/// The last full state $(t, q, \dot q)$ a check of the groups saw, with a version of
+/// its position $(t, q)$ and of the whole state: a group of evaluations is stamped
+/// with the version it was made at, so that the stamps are numbers, and the state is
+/// copied once when it changes instead of once per group evaluated at it.
 #[derive(Debug)]
-struct Stamp {
-    valid: bool,
+struct Versions {
     t: f64,
     q: Vec<f64>,
     qd: Vec<f64>,
+    position: u64,
+    state: u64,
 }
 
-impl Stamp {
-    fn new(n: usize, velocities: bool) -> Self {
+impl Versions {
+    fn new(n: usize) -> Self {
         Self {
-            valid: false,
-            t: 0.0,
+            // No time equals it bitwise but this NaN: the first check starts version 2.
+            t: f64::NAN,
             q: vec![0.0; n],
-            qd: vec![0.0; if velocities { n } else { 0 }],
+            qd: vec![0.0; n],
+            position: 1,
+            state: 1,
         }
     }
 
-    /// Whether the group holds values at `(t, q, qd)` (`qd` ignored for position-only
-    /// groups).
+    /// The versions `(position, state)` of `(t, q, qd)`: those of the last state seen
+    /// when it is the same (`t` bitwise, `q` and `qd` by value), new ones otherwise
+    /// (the state then copied).
     #[inline]
-    fn matches(&self, t: f64, q: &[f64], qd: &[f64]) -> bool {
-        self.valid
-            && self.t.to_bits() == t.to_bits()
-            && self.q == q
-            && (self.qd.is_empty() || self.qd == qd)
-    }
-
-    /// Records that the group now holds values at `(t, q, qd)`.
-    #[inline]
-    fn set(&mut self, t: f64, q: &[f64], qd: &[f64]) {
-        self.valid = true;
-        self.t = t;
-        self.q.copy_from_slice(q);
-        if !self.qd.is_empty() {
+    fn sync(&mut self, t: f64, q: &[f64], qd: &[f64]) -> (u64, u64) {
+        if self.t.to_bits() != t.to_bits() || !same(&self.q, q) {
+            self.t = t;
+            self.q.copy_from_slice(q);
             self.qd.copy_from_slice(qd);
+            self.position += 1;
+            self.state += 1;
+        } else if !same(&self.qd, qd) {
+            self.qd.copy_from_slice(qd);
+            self.state += 1;
         }
-    }
-
-    /// [`matches`](Self::matches); otherwise invalidates the stamp, for the caller to
-    /// evaluate and [`set`](Self::set) it.
-    #[inline]
-    fn check(&mut self, t: f64, q: &[f64], qd: &[f64]) -> bool {
-        let same = self.matches(t, q, qd);
-        self.valid &= same;
-        same
+        (self.position, self.state)
     }
 }
+
+/// Whether `a` and `b` are equal entry by entry (by value, as `==`), in one pass without
+/// branches (vectorized).
+#[inline]
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.iter().zip(b).fold(true, |s, (x, y)| s & (x == y))
+}
+
+/// The version of the state a group of evaluations holds values at (0: none).
+type Stamp = u64;
 
 /// How often a [`Point`] evaluated the holonomic constraints and their Jacobian, and
 /// how: the fused evaluation computes both for little more than either.
@@ -105,8 +112,9 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     pub newton: NewtonParams,
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
-    pub qdd: Vec<f64>,
-    pub lambda: Vec<f64>,
+    /// $[\ddot q; \lambda]$, where the augmented solve writes them (see
+    /// [`qdd`](Self::qdd), [`lambda`](Self::lambda)).
+    pub solution: Vec<f64>,
     /// $[C_q\dot q + C_t;\ G\dot q + g]$ (see
     /// [`velocity_residuals`](Self::velocity_residuals)).
     pub vel: Vec<f64>,
@@ -116,6 +124,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// whose projected rows are all holonomic (see [`Point::project`]).
     position_factor: bool,
     lu_v: SmallCholesky,
+    /// The products of the Gram matrices of `lu_h` (the holonomic rows of `rows`) and
+    /// `lu_v` (all of `rows`) the sparsity of $J$ leaves (see [`GramPlan`]).
+    gram_h: GramPlan,
+    gram_v: GramPlan,
     /// Scratch of a velocity update.
     dx: Vec<f64>,
     /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
@@ -127,7 +139,9 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// $C$; the pattern values of $C_q$, $G$ (written by their own functions or by the
     /// dynamics terms); the dense $J$; $C_t$, $g$; the dynamics terms ($M$, $Q$,
     /// $\gamma$); $\ddot q$, $\lambda$ (solved with the formulation's shift, a function
-    /// of the state).
+    /// of the state). Position groups hold a version of $(t, q)$, the others one of
+    /// $(t, q, \dot q)$ ([`Versions`]).
+    versions: Versions,
     constraints: Stamp,
     jacobian: Stamp,
     dense: Stamp,
@@ -163,7 +177,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     ) -> Result<Self, Error> {
         let info = mech.info();
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
-        Ok(Self {
+        let mut point = Self {
             mech,
             info,
             ws: Workspace::new(info)?,
@@ -172,30 +186,34 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             newton: kin.newton,
             q: vec![0.0; n],
             qd: vec![0.0; n],
-            qdd: vec![0.0; n],
-            lambda: vec![0.0; m],
+            solution: vec![0.0; n + m],
             vel: vec![0.0; m],
             mu: vec![0.0; m],
             lu_h: SmallCholesky::new(mh),
             position_factor: false,
             lu_v: SmallCholesky::new(m),
+            gram_h: GramPlan::default(),
+            gram_v: GramPlan::default(),
             dx: vec![0.0; n],
             mass: SmallCholesky::new(0),
             rows: (0..m).collect(),
             rows_h: mh,
-            constraints: Stamp::new(n, false),
-            jacobian: Stamp::new(n, false),
-            dense: Stamp::new(n, false),
-            rates: Stamp::new(n, false),
-            terms: Stamp::new(n, true),
-            solved: Stamp::new(n, true),
+            versions: Versions::new(n),
+            constraints: 0,
+            jacobian: 0,
+            dense: 0,
+            rates: 0,
+            terms: 0,
+            solved: 0,
             paired: false,
             evaluations: PositionEvaluations::default(),
             newton_iterations: 0,
             factorizations: 0,
             redundant: Vec::new(),
             constraints_with_terms: false,
-        })
+        };
+        point.plan_grams();
+        Ok(point)
     }
 
     /// Sets the state to $y = [q; \dot q]$ (a state from the integrator). Whether $C$
@@ -220,14 +238,37 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             &mut self.terms,
             &mut self.solved,
         ] {
-            s.valid = false;
+            *s = 0;
         }
     }
 
     /// Forgets $\ddot q$ and $\lambda$ (after a resting contact corrected them in
     /// place, so that the next solve starts from the model's own equations).
     pub fn invalidate_solved(&mut self) {
-        self.solved.valid = false;
+        self.solved = 0;
+    }
+
+    /// $\ddot q$ of the last solve.
+    pub fn qdd(&self) -> &[f64] {
+        &self.solution[..self.info.nq()]
+    }
+
+    /// $\lambda$ of the last solve.
+    pub fn lambda(&self) -> &[f64] {
+        &self.solution[self.info.nq()..]
+    }
+
+    /// The versions `(position, state)` of the current $(t, q, \dot q)$
+    /// ([`Versions::sync`]).
+    #[inline]
+    fn versions(&mut self, t: f64) -> (u64, u64) {
+        self.versions.sync(t, &self.q, &self.qd)
+    }
+
+    /// The version of the current $(t, q)$.
+    #[inline]
+    fn position(&mut self, t: f64) -> u64 {
+        self.versions(t).0
     }
 
     /// Keeps only the independent holonomic rows `holonomic` (and every non-holonomic
@@ -243,6 +284,24 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.lu_h = SmallCholesky::new(self.rows_h);
             self.lu_v = SmallCholesky::new(self.rows.len());
         }
+        self.plan_grams();
+    }
+
+    /// The plans of the projections' Gram matrices for the current `rows`, from the
+    /// patterns of $C_q$ and $G$ (allocates).
+    fn plan_grams(&mut self) {
+        let info = self.info;
+        let (n, mh) = (info.nq(), info.nh());
+        let mut nonzero = vec![false; (mh + info.nnh()) * n];
+        for &(r, c) in info.holonomic_pattern {
+            nonzero[r as usize * n + c as usize] = true;
+        }
+        for &(r, c) in info.nonholonomic_pattern {
+            nonzero[(mh + r as usize) * n + c as usize] = true;
+        }
+        let nonzero = |i: usize, j: usize| nonzero[i * n + j];
+        self.gram_h = GramPlan::new(&self.rows[..self.rows_h], n, nonzero);
+        self.gram_v = GramPlan::new(&self.rows, n, nonzero);
     }
 
     /// Fits the projections to the current partition, which may have dropped redundant
@@ -301,13 +360,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// both call
     /// [`constraints_with_jacobian`](Self::constraints_with_jacobian).
     pub fn constraints(&mut self, t: f64) -> Result<&[f64], EvalError> {
-        if !self.constraints.check(t, &self.q, &[]) {
-            if self.paired && !self.jacobian.check(t, &self.q, &[]) {
-                self.eval_fused(t)?;
+        let at = self.position(t);
+        if self.constraints != at {
+            if self.paired && self.jacobian != at {
+                self.eval_fused(t, at)?;
             } else {
                 self.ws.eval_constraints(self.mech, t, &self.q)?;
                 self.evaluations.constraints += 1;
-                self.constraints.set(t, &self.q, &[]);
+                self.constraints = at;
             }
             self.paired = false;
         }
@@ -317,19 +377,22 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// $C$ and the pattern values of $C_q$ and $G$ at the current $(t, q)$, by one
     /// fused evaluation when neither is held.
     pub fn constraints_with_jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
-        let held = (
-            self.constraints.check(t, &self.q, &[]),
-            self.jacobian.check(t, &self.q, &[]),
-        );
-        match held {
+        let at = self.position(t);
+        self.constraints_with_jacobian_values_at(t, at)
+    }
+
+    /// [`constraints_with_jacobian_values`](Self::constraints_with_jacobian_values) at
+    /// the current $(t, q)$ of version `at`.
+    fn constraints_with_jacobian_values_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
+        match (self.constraints == at, self.jacobian == at) {
             (true, true) => {}
-            (false, false) => self.eval_fused(t)?,
+            (false, false) => self.eval_fused(t, at)?,
             (false, true) => {
                 self.ws.eval_constraints(self.mech, t, &self.q)?;
                 self.evaluations.constraints += 1;
-                self.constraints.set(t, &self.q, &[]);
+                self.constraints = at;
             }
-            (true, false) => self.jacobian_values(t)?,
+            (true, false) => self.jacobian_values_at(t, at)?,
         }
         self.paired = true;
         Ok(())
@@ -339,49 +402,57 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// [`constraints_with_jacobian_values`](Self::constraints_with_jacobian_values)),
     /// read with [`Workspace::constraints`] and [`Workspace::jacobian`].
     pub fn constraints_with_jacobian(&mut self, t: f64) -> Result<(), EvalError> {
-        self.constraints_with_jacobian_values(t)?;
-        self.dense_jacobian(t)?;
-        Ok(())
+        let at = self.position(t);
+        self.constraints_with_jacobian_values_at(t, at)?;
+        self.dense_jacobian_at(t, at)
     }
 
-    /// $C$, $C_q$ (one fused call) and $G$ at the current $(t, q)$, stamped.
-    fn eval_fused(&mut self, t: f64) -> Result<(), EvalError> {
+    /// $C$, $C_q$ (one fused call) and $G$ at the current $(t, q)$, of version `at`,
+    /// stamped.
+    fn eval_fused(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         self.ws
             .eval_constraints_with_jacobian(self.mech, t, &self.q)?;
         self.evaluations.fused += 1;
-        self.constraints.set(t, &self.q, &[]);
-        self.jacobian.set(t, &self.q, &[]);
+        self.constraints = at;
+        self.jacobian = at;
         Ok(())
     }
 
     /// Notes that $J$ is asked for: after $C$ at the same point, the next $C$ at a new
     /// point comes with $J$ (see [`constraints`](Self::constraints)).
-    fn note_jacobian(&mut self, t: f64) {
-        if !self.paired && self.constraints.matches(t, &self.q, &[]) {
+    fn note_jacobian(&mut self, at: Stamp) {
+        if !self.paired && self.constraints == at {
             self.paired = true;
         }
     }
 
-    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$.
-    fn jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
-        self.note_jacobian(t);
-        if !self.jacobian.check(t, &self.q, &[]) {
+    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$, of version `at`.
+    fn jacobian_values_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
+        self.note_jacobian(at);
+        if self.jacobian != at {
             self.ws.eval_jacobian_values(self.mech, t, &self.q)?;
             self.evaluations.jacobian += 1;
-            self.jacobian.set(t, &self.q, &[]);
+            self.jacobian = at;
         }
         Ok(())
     }
 
     /// The dense $J$ at the current $(t, q)$.
     pub fn dense_jacobian(&mut self, t: f64) -> Result<&[f64], EvalError> {
-        self.note_jacobian(t);
-        if !self.dense.check(t, &self.q, &[]) {
-            self.jacobian_values(t)?;
-            self.ws.scatter_jacobian();
-            self.dense.set(t, &self.q, &[]);
-        }
+        let at = self.position(t);
+        self.dense_jacobian_at(t, at)?;
         Ok(self.ws.jacobian())
+    }
+
+    /// [`dense_jacobian`](Self::dense_jacobian) at the current $(t, q)$ of version `at`.
+    fn dense_jacobian_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
+        self.note_jacobian(at);
+        if self.dense != at {
+            self.jacobian_values_at(t, at)?;
+            self.ws.scatter_jacobian();
+            self.dense = at;
+        }
+        Ok(())
     }
 
     /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
@@ -389,10 +460,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
         let info = self.info;
         let mh = info.nh();
-        self.jacobian_values(t)?;
-        if !self.rates.check(t, &self.q, &[]) {
+        let at = self.position(t);
+        self.jacobian_values_at(t, at)?;
+        if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
-            self.rates.set(t, &self.q, &[]);
+            self.rates = at;
         }
         self.vel[..mh].copy_from_slice(&self.ws.ct);
         self.vel[mh..].copy_from_slice(&self.ws.bias);
@@ -420,27 +492,21 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// of the model's fused evaluation.
     pub fn accelerations(&mut self, t: f64, shift: Option<&[f64]>) -> Result<(), SimErrorKind> {
         // A shift depends on the state only, so (t, q, q̇) identifies the solution.
-        if self.solved.check(t, &self.q, &self.qd) {
+        let (position, state) = self.versions(t);
+        if self.solved == state {
             return Ok(());
         }
-        self.dynamics_terms(t)?;
+        self.dynamics_terms_at(t, (position, state), self.constraints_with_terms)?;
         self.factorizations += 1;
         let stats = self
             .dynamics
-            .solve_evaluated(
-                self.mech,
-                &mut self.ws,
-                t,
-                shift,
-                &mut self.qdd,
-                &mut self.lambda,
-            )
+            .solve_evaluated(self.mech, &mut self.ws, t, shift, &mut self.solution)
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
-            self.dense.set(t, &self.q, &[]);
+            self.dense = position;
         }
-        self.solved.set(t, &self.q, &self.qd);
+        self.solved = state;
         // Reported once, as first identified: which rows of a dependent set the
         // pivoting names can change along the motion, the redundancy does not.
         if self.redundant.is_empty() {
@@ -453,11 +519,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too,
     /// and $C$ when [`constraints_with_terms`](Self::constraints_with_terms)).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        if !self.terms.check(t, &self.q, &self.qd) {
-            let with_c = self.constraints_with_terms && !self.constraints.check(t, &self.q, &[]);
-            self.eval_terms(t, with_c)?;
-        }
-        Ok(())
+        let versions = self.versions(t);
+        self.dynamics_terms_at(t, versions, self.constraints_with_terms)
     }
 
     /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
@@ -465,30 +528,39 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// sines it already has), [`constraints`](Self::constraints) when the terms are.
     /// For callers that read $C$ at every point (Baumgarte's shift).
     pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        let held = self.constraints.check(t, &self.q, &[]);
-        if !self.terms.check(t, &self.q, &self.qd) {
-            self.eval_terms(t, !held)?;
-        } else if !held {
+        let versions = self.versions(t);
+        self.dynamics_terms_at(t, versions, true)?;
+        if self.constraints != versions.0 {
             self.constraints(t).map_err(SimErrorKind::from_eval)?;
         }
         Ok(())
     }
 
-    /// One call of the fused evaluation at the current state, asking for $C$ too when
-    /// `constraints`. Without it the workspace's $C$ is not written, so its stamp
+    /// [`dynamics_terms`](Self::dynamics_terms) at the current state, of versions
+    /// `(position, state)`, asking for $C$ too when `constraints` and $C$ is not held
+    /// at the position. Without it the workspace's $C$ is not written, so its stamp
     /// stays true.
-    fn eval_terms(&mut self, t: f64, constraints: bool) -> Result<(), SimErrorKind> {
-        self.jacobian.valid = false;
-        if constraints {
-            self.constraints.valid = false;
-        }
-        self.ws
-            .eval_dynamics_terms_with(self.mech, t, &self.q, &self.qd, constraints)
-            .map_err(SimErrorKind::from_eval)?;
-        self.terms.set(t, &self.q, &self.qd);
-        self.jacobian.set(t, &self.q, &[]);
-        if constraints {
-            self.stamp_terms_constraints(t);
+    #[inline]
+    fn dynamics_terms_at(
+        &mut self,
+        t: f64,
+        (position, state): (Stamp, Stamp),
+        constraints: bool,
+    ) -> Result<(), SimErrorKind> {
+        if self.terms != state {
+            let with_c = constraints && self.constraints != position;
+            self.jacobian = 0;
+            if with_c {
+                self.constraints = 0;
+            }
+            self.ws
+                .eval_dynamics_terms_with(self.mech, t, &self.q, &self.qd, with_c)
+                .map_err(SimErrorKind::from_eval)?;
+            self.terms = state;
+            self.jacobian = position;
+            if with_c {
+                self.stamp_terms_constraints(position);
+            }
         }
         Ok(())
     }
@@ -496,9 +568,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// Stamps the $C$ the dynamics terms wrote, when it is finite (a non-finite one is
     /// left for [`constraints`](Self::constraints) to evaluate and report, as before
     /// the terms carried it).
-    fn stamp_terms_constraints(&mut self, t: f64) {
-        if self.ws.constraints().iter().all(|c| c.is_finite()) {
-            self.constraints.set(t, &self.q, &[]);
+    fn stamp_terms_constraints(&mut self, position: Stamp) {
+        if all_finite(self.ws.constraints()) {
+            self.constraints = position;
         }
     }
 
@@ -513,15 +585,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         t: f64,
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
     ) -> Result<(), EvalError> {
-        if !self.rates.check(t, &self.q, &[]) {
+        let at = self.position(t);
+        if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
-            self.rates.set(t, &self.q, &[]);
+            self.rates = at;
         }
-        let with_c = self.constraints_with_terms && !self.constraints.check(t, &self.q, &[]);
-        self.jacobian.valid = false;
-        self.terms.valid = false;
+        let with_c = self.constraints_with_terms && self.constraints != at;
+        self.jacobian = 0;
+        self.terms = 0;
         if with_c {
-            self.constraints.valid = false;
+            self.constraints = 0;
         }
         self.ws.eval_dynamics_terms_corrected(
             self.mech,
@@ -531,10 +604,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             with_c,
             correct,
         )?;
-        self.terms.set(t, &self.q, &self.qd);
-        self.jacobian.set(t, &self.q, &[]);
+        // The velocities may have changed: a new state version, the same position.
+        let (position, state) = self.versions(t);
+        self.terms = state;
+        self.jacobian = position;
         if with_c {
-            self.stamp_terms_constraints(t);
+            self.stamp_terms_constraints(position);
         }
         Ok(())
     }
@@ -542,7 +617,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
     /// $\lambda = 0$.
     pub fn free_accelerations(&mut self, t: f64) -> Result<(), SimErrorKind> {
-        if self.solved.check(t, &self.q, &self.qd) {
+        let state = self.versions(t).1;
+        if self.solved == state {
             return Ok(());
         }
         self.dynamics_terms(t)?;
@@ -566,10 +642,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 constraints: Vec::new(),
             });
         }
-        self.qdd.copy_from_slice(&self.ws.forces);
-        self.mass.solve(&mut self.qdd);
-        self.lambda.fill(0.0);
-        self.solved.set(t, &self.q, &self.qd);
+        let (qdd, lambda) = self.solution.split_at_mut(n);
+        qdd.copy_from_slice(&self.ws.forces);
+        self.mass.solve(qdd);
+        lambda.fill(0.0);
+        self.solved = state;
         Ok(())
     }
 
@@ -712,8 +789,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                         constraints: self.violated(t, tol),
                     });
                 }
-                let rows = &self.rows[..self.rows_h];
-                let ratio = gram_cholesky(&mut self.lu_h, self.ws.jacobian(), rows, n);
+                let ratio = gram_cholesky_planned(&mut self.lu_h, self.ws.jacobian(), &self.gram_h);
                 if (ratio.is_nan() || ratio <= REFIT_RATIO) && !refitted && self.refit(t) {
                     refitted = true;
                     continue;
@@ -758,11 +834,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let eval = SimErrorKind::from_eval;
         self.velocity_residuals(t).map_err(eval)?;
         self.dense_jacobian(t).map_err(eval)?;
-        let mut ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+        let mut ratio = gram_cholesky_planned(&mut self.lu_v, self.ws.jacobian(), &self.gram_v);
         if (ratio.is_nan() || ratio <= REFIT_RATIO) && self.refit(t) {
             self.velocity_residuals(t).map_err(eval)?;
             self.dense_jacobian(t).map_err(eval)?;
-            ratio = gram_cholesky(&mut self.lu_v, self.ws.jacobian(), &self.rows, n);
+            ratio = gram_cholesky_planned(&mut self.lu_v, self.ws.jacobian(), &self.gram_v);
         }
         let rows = &self.rows[..];
         self.factorizations += 1;

@@ -122,7 +122,7 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
         match r {
             Ok(()) => {
                 dy[..n].copy_from_slice(&self.point.qd);
-                dy[n..].copy_from_slice(&self.point.qdd);
+                dy[n..].copy_from_slice(self.point.qdd());
                 Ok(())
             }
             Err(e) => {
@@ -269,7 +269,7 @@ impl<'a, M: Mechanism + ?Sized> StateSpace<'a, M> {
     /// The multipliers of the last evaluation.
     #[must_use]
     pub fn multipliers(&self) -> &[f64] {
-        &self.0.point.lambda
+        self.0.point.lambda()
     }
 
     /// The typed failure of the last evaluation that failed (the integrators carry a
