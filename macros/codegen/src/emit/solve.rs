@@ -29,10 +29,10 @@
 //! $\tilde M$ positive definite; $\rho = \sum_c M_{cc} / \sum_c J_{rc}^2$ gives the
 //! added block the trace of $M$'s, so it does not depend on the units.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use proc_macro2::{Literal, TokenStream};
-use quote::quote;
+use quote::{quote, ToTokens};
 
 use crate::derive::Entry;
 use crate::sym::{ExprId, Graph, Node, Var};
@@ -254,11 +254,79 @@ impl Plan {
             .collect()
     }
 
+    /// The positions `j` with `k` in their column, per position `k` (ascending): the
+    /// entries of row `k` of $L$.
+    fn rows(&self) -> Vec<Vec<usize>> {
+        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); self.order.len()];
+        for (j, c) in self.columns.iter().enumerate() {
+            for &i in c {
+                rows[i].push(j);
+            }
+        }
+        rows
+    }
+
+    /// The pattern of $Y = I - L_{SS}^{-1}$, $L_{SS}$ the block of $L$ in the
+    /// multipliers' rows and columns: per entry `(p, q)`, `p > q`, whether $l_{pq}$ is
+    /// an entry and the positions `j` of its terms $l_{pj} Y_{jq}$, $q < j < p$.
+    fn inverse(&self) -> BTreeMap<(usize, usize), (bool, Vec<usize>)> {
+        let (n, dim) = (self.n, self.order.len());
+        let rows = self.rows();
+        let mut y: BTreeMap<(usize, usize), (bool, Vec<usize>)> = BTreeMap::new();
+        for p in n..dim {
+            for q in n..p {
+                let direct = rows[p].binary_search(&q).is_ok();
+                let terms: Vec<usize> = rows[p]
+                    .iter()
+                    .copied()
+                    .filter(|&j| j > q && y.contains_key(&(j, q)))
+                    .collect();
+                if direct || !terms.is_empty() {
+                    y.insert((p, q), (direct, terms));
+                }
+            }
+        }
+        y
+    }
+
+    /// The operations the explicit inverse of $L_{SS}$ adds to the solve (its entries
+    /// and the products $Y^\mathsf{T}\zeta$, less the back substitution they replace).
+    fn inverse_operations(&self) -> usize {
+        let y = self.inverse();
+        let made: usize = y.values().map(|(_, t)| 2 * t.len() + 1).sum();
+        let used = 2 * y.len();
+        let replaced: usize = self.columns[self.n..].iter().map(|c| 2 * c.len()).sum();
+        (made + used).saturating_sub(replaced)
+    }
+
     /// The trait method.
+    ///
+    /// **Emitted for the critical path.** The solve is a chain of dependent
+    /// operations, not a flop count: each pivot's reciprocal (a division) is needed by
+    /// the next pivot, and the substitutions are chains through the unknowns. The code
+    /// is therefore built with a model of when each value is ready (additions and
+    /// multiplications [`ADD`], [`MUL`] cycles, divisions [`DIV`], the inputs at 0), and
+    /// every sum is combined as a tree, the two earliest ready operands first (which
+    /// minimizes the time of the result), every product of three factors the two
+    /// earliest first. A term $l_{ij} w_{kj}$ of an update is written as
+    /// $(w_{ij} w_{kj}) r_j$ when that is ready earlier (the product of the `w` waits
+    /// for no division), the forward substitution is folded into the factorization
+    /// (`y`, computed with the rows of $L$ as they appear), and when it is cheap enough
+    /// (it adds at most half the operations of the rest, `Plan::inverse_operations`) the
+    /// unit triangle of the multipliers' block is inverted alongside the factorization
+    /// (its rows wait for no division), so that the multipliers are independent dot
+    /// products after the last pivot instead of a chain of `m` substitutions.
+    ///
+    /// Sign convention: in the multipliers' block the code holds $-w$ and $-d$ (the
+    /// positive Schur complement $S = J M^{-1} J^\mathsf{T}$ and its pivots), so that
+    /// every reciprocal `r` is positive and $l = w r$ holds in both blocks; `z` is
+    /// $y r$ ($D^{-1} y$ up to that sign) and `s` the solution ($-\lambda$ in the
+    /// multipliers).
     pub fn emit(&self) -> TokenStream {
         let n = self.n;
         let dim = self.order.len();
-        // Index of the entry (i, k), i > k, of L in the arrays `w` (L D) and `l`.
+        let lit = Literal::usize_unsuffixed;
+        // Index of the entry (i, k), i > k, of L.
         let mut index = HashMap::new();
         for (k, c) in self.columns.iter().enumerate() {
             for &i in c {
@@ -266,8 +334,6 @@ impl Plan {
                 index.insert((i, k), next);
             }
         }
-        let lit = Literal::usize_unsuffixed;
-        let entry = |i: usize, k: usize| lit(index[&(i, k)]);
         // The terms ρ J_ra J_rb of the rows added to M, by entry (a, b).
         let mut added: HashMap<(usize, usize), TokenStream> = HashMap::new();
         let mut code = TokenStream::new();
@@ -295,148 +361,251 @@ impl Plan {
                 }
             }
         }
-        let source = |i: usize, k: usize| {
+        // The ready time of an entry with added terms (ρ: two sums and a division).
+        let added_ready = DIV + 3 * ADD + MUL;
+        let source = |i: usize, k: usize| -> Option<Operand> {
             let (vi, vk) = (self.order[i], self.order[k]);
             self.entries.get(&(vi, vk)).map(|s| match *s {
                 Source::Mass(e) => {
                     let e = lit(e);
                     match added.get(&(vi, vk)) {
-                        Some(t) => quote!((mass[#e] #t)),
-                        None => quote!(mass[#e]),
+                        Some(t) => Operand::new(quote!((mass[#e] #t)), added_ready),
+                        None => Operand::new(quote!(mass[#e]), 0),
                     }
                 }
                 Source::Holonomic(e) => {
                     let e = lit(e);
-                    quote!(cq[#e])
+                    Operand::new(quote!(cq[#e]), 0)
                 }
                 Source::Nonholonomic(e) => {
                     let e = lit(e);
-                    quote!(g[#e])
+                    Operand::new(quote!(g[#e]), 0)
                 }
             })
         };
-        // a − Σ l[ij] w[kj] (`a` absent: a structural zero).
-        let update = |a: Option<TokenStream>, i: usize, k: usize, js: &[usize]| {
-            let mut e = a.unwrap_or_default();
-            for (t, &j) in js.iter().enumerate() {
-                let (ij, kj) = (entry(i, j), entry(k, j));
-                e = if t == 0 && e.is_empty() {
-                    quote!(-(l[#ij] * w[#kj]))
-                } else {
-                    quote!(#e - l[#ij] * w[#kj])
-                };
+        let name = |prefix: &str, k: usize| quote::format_ident!("{}{}", prefix, k);
+        // Ready times of the values: w (L D, by entry), l (by entry), d and r (pivot and
+        // its reciprocal, by position), y, z and s (by position), t (Y, by entry).
+        let mut w_at = vec![0; index.len()];
+        let mut l_at = vec![0; index.len()];
+        let (mut d_at, mut r_at) = (vec![0; dim], vec![0; dim]);
+        let (mut y_at, mut z_at, mut s_at) = (vec![0; dim], vec![0; dim], vec![0; dim]);
+        // V(i, k): w for i > k, d for i = k.
+        let v = |i: usize, k: usize, w_at: &[u32], d_at: &[u32]| {
+            if i == k {
+                Operand::new(name("d", k).into_token_stream(), d_at[k])
+            } else {
+                let e = index[&(i, k)];
+                Operand::new(name("w", e).into_token_stream(), w_at[e])
             }
-            e
+        };
+        let ell = |i: usize, k: usize, l_at: &[u32]| {
+            let e = index[&(i, k)];
+            Operand::new(name("l", e).into_token_stream(), l_at[e])
         };
         let ratio: TokenStream = format!("{PIVOT_RATIO:e}").parse().expect("a literal");
+        let declined = quote!(return ::pfaff::__private::AugmentedSolve::Declined;);
+        let rows = self.rows();
+        let inverse = (self.inverse_operations() <= self.operations / 2
+            && self.operations + self.inverse_operations() <= BUDGET)
+            .then(|| self.inverse());
+        let mut t_at: HashMap<(usize, usize), u32> = HashMap::new();
+        let t_name = |p: usize, q: usize| quote::format_ident!("t{}_{}", p, q);
         for (k, terms) in self.updates().iter().enumerate() {
-            let v = self.order[k];
-            let kl = lit(k);
-            if v < n {
-                let mut a = source(k, k).expect("a diagonal mass entry");
-                if let Some(t) = added.get(&(v, v)) {
-                    let e = match self.entries[&(v, v)] {
-                        Source::Mass(e) => lit(e),
-                        _ => unreachable!("a diagonal mass entry"),
+            let multiplier = self.order[k] >= n;
+            // The forward substitution's row k: y_k = b_k − Σ l_kj y_j.
+            let b = lit(self.order[k]);
+            let mut items = vec![(false, Operand::new(quote!(x[#b]), 0))];
+            for &j in &rows[k] {
+                let a = Operand::product(vec![
+                    ell(k, j, &l_at),
+                    Operand::new(name("y", j).into_token_stream(), y_at[j]),
+                ]);
+                let b = Operand::product(vec![
+                    v(k, j, &w_at, &d_at),
+                    Operand::new(name("z", j).into_token_stream(), z_at[j]),
+                ]);
+                items.push((true, Operand::earlier(a, b)));
+            }
+            let y = Operand::sum(items);
+            y_at[k] = y.ready;
+            let (yn, yc) = (name("y", k), y.code);
+            code.extend(quote!(let #yn = #yc;));
+            // Row k of Y (the multipliers' block): Y_kq = l_kq − Σ l_kj Y_jq.
+            if let Some(inverse) = &inverse {
+                for q in n..k {
+                    let Some((direct, js)) = inverse.get(&(k, q)) else {
+                        continue;
                     };
-                    code.extend(quote!(let a = mass[#e] #t;));
-                    a = quote!(a);
-                }
-                let d = update(Some(a.clone()), k, k, &terms[&k]);
-                code.extend(quote! {
-                    let d = #d;
-                    if !(d > #ratio * #a) {
-                        return ::pfaff::__private::AugmentedSolve::Declined;
+                    let mut items = Vec::new();
+                    if *direct {
+                        items.push((false, ell(k, q, &l_at)));
                     }
-                    r[#kl] = 1.0 / d;
+                    for &j in js {
+                        let t = Operand::new(t_name(j, q).into_token_stream(), t_at[&(j, q)]);
+                        items.push((true, Operand::product(vec![ell(k, j, &l_at), t])));
+                    }
+                    let t = Operand::sum(items);
+                    t_at.insert((k, q), t.ready);
+                    let (tn, tc) = (t_name(k, q), t.code);
+                    code.extend(quote!(let #tn = #tc;));
+                }
+            }
+            // A term ± l_ij w_kj of the update of entry (i, k), in its earliest form.
+            let term = |i: usize, j: usize, at: (&[u32], &[u32], &[u32], &[u32])| {
+                let (w_at, l_at, d_at, r_at) = at;
+                let (vi, vk) = (v(i, j, w_at, d_at), v(k, j, w_at, d_at));
+                let r = Operand::new(name("r", j).into_token_stream(), r_at[j]);
+                let mut cheap = Operand::product(vec![ell(i, j, l_at), vk.clone()]);
+                if i != k {
+                    let other = Operand::product(vec![ell(k, j, l_at), vi.clone()]);
+                    cheap = Operand::earlier(cheap, other);
+                }
+                let fast = Operand::product(vec![vi, vk, r]);
+                (cheap, fast)
+            };
+            // The pivot, checked against the diagonal it started from.
+            let dn = name("d", k);
+            if !multiplier {
+                let mut a = source(k, k).expect("a diagonal mass entry");
+                if added.contains_key(&(self.order[k], self.order[k])) {
+                    let an = name("a", k);
+                    let ac = a.code;
+                    code.extend(quote!(let #an = #ac;));
+                    a = Operand::new(an.into_token_stream(), a.ready);
+                }
+                let mut items = vec![Choice::one(false, a.clone())];
+                for &j in &terms[&k] {
+                    items.push(Choice::of(true, term(k, j, (&w_at, &l_at, &d_at, &r_at))));
+                }
+                let d = Choice::sum(items);
+                d_at[k] = d.ready;
+                let (dc, ac) = (d.code, a.code);
+                code.extend(quote! {
+                    let #dn = #dc;
+                    if !(#dn > #ratio * #ac) {
+                        #declined
+                    }
                 });
             } else {
+                // S_kk = Σ l w over the coordinates; the pivot S_kk − Σ l w over the
+                // earlier multipliers.
                 let (coordinates, multipliers): (Vec<usize>, Vec<usize>) =
                     terms[&k].iter().partition(|&&j| self.order[j] < n);
-                // S_kk = Σ l w over the coordinates; −pivot = S_kk + Σ l w over the
-                // earlier multipliers (each l w < 0 there).
-                let products = |js: &[usize]| -> Vec<TokenStream> {
-                    js.iter()
-                        .map(|&j| {
-                            let kj = entry(k, j);
-                            quote!(l[#kj] * w[#kj])
-                        })
-                        .collect()
-                };
-                let (s, more) = (products(&coordinates), products(&multipliers));
-                let s = if s.is_empty() {
-                    quote!(0.0)
+                let items = coordinates
+                    .iter()
+                    .map(|&j| Choice::of(false, term(k, j, (&w_at, &l_at, &d_at, &r_at))))
+                    .collect::<Vec<_>>();
+                let s = if items.is_empty() {
+                    Operand::new(quote!(0.0), 0)
                 } else {
-                    quote!(#(#s)+*)
+                    Choice::sum(items)
                 };
-                code.extend(if more.is_empty() {
-                    quote! {
-                        let s = #s;
-                        if !(s > 0.0) {
-                            return ::pfaff::__private::AugmentedSolve::Declined;
+                let (cn, sc) = (name("c", k), s.code);
+                code.extend(quote!(let #cn = #sc;));
+                let c = Operand::new(cn.to_token_stream(), s.ready);
+                if multipliers.is_empty() {
+                    d_at[k] = c.ready;
+                    code.extend(quote! {
+                        let #dn = #cn;
+                        if !(#dn > 0.0) {
+                            #declined
                         }
-                        r[#kl] = -1.0 / s;
-                    }
+                    });
                 } else {
-                    quote! {
-                        let s = #s;
-                        let d = s #(+ #more)*;
-                        if !(d > #ratio * s) {
-                            return ::pfaff::__private::AugmentedSolve::Declined;
-                        }
-                        r[#kl] = -1.0 / d;
+                    let mut items = vec![Choice::one(false, c)];
+                    for &j in &multipliers {
+                        items.push(Choice::of(true, term(k, j, (&w_at, &l_at, &d_at, &r_at))));
                     }
-                });
+                    let d = Choice::sum(items);
+                    d_at[k] = d.ready;
+                    let dc = d.code;
+                    code.extend(quote! {
+                        let #dn = #dc;
+                        if !(#dn > #ratio * #cn) {
+                            #declined
+                        }
+                    });
+                }
             }
-            for &i in &self.columns[k] {
-                let e = entry(i, k);
-                let w = update(source(i, k), i, k, &terms[&i]);
-                code.extend(quote! {
-                    w[#e] = #w;
-                    l[#e] = w[#e] * r[#kl];
-                });
-            }
-        }
-        // L y = b, then x = D⁻¹ y − Lᵀ x (rows from the last).
-        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); dim];
-        for (j, c) in self.columns.iter().enumerate() {
-            for &i in c {
-                rows[i].push(j);
-            }
-        }
-        for (k, js) in rows.iter().enumerate() {
-            if js.is_empty() {
+            let (rn, zn, yn) = (name("r", k), name("z", k), name("y", k));
+            if self.columns[k].is_empty() {
+                // No column: the reciprocal would serve z alone.
+                z_at[k] = d_at[k].max(y_at[k]) + DIV;
+                code.extend(quote!(let #zn = #yn / #dn;));
                 continue;
             }
-            let v = lit(self.order[k]);
-            let mut e = quote!(x[#v]);
-            for &j in js {
-                let (kj, vj) = (entry(k, j), lit(self.order[j]));
-                e = quote!(#e - l[#kj] * x[#vj]);
-            }
-            code.extend(quote!(x[#v] = #e;));
-        }
-        for k in (0..dim).rev() {
-            let (v, kl) = (lit(self.order[k]), lit(k));
-            let mut e = quote!(x[#v] * r[#kl]);
+            r_at[k] = d_at[k] + DIV;
+            z_at[k] = r_at[k].max(y_at[k]) + MUL;
+            code.extend(quote! {
+                let #rn = 1.0 / #dn;
+                let #zn = #yn * #rn;
+            });
+            // The column: w_ik = a_ik − Σ l_ij w_kj (the sign of the block in the
+            // multipliers' rows and columns), l_ik = w_ik r_k.
             for &i in &self.columns[k] {
-                let (ik, vi) = (entry(i, k), lit(self.order[i]));
-                e = quote!(#e - l[#ik] * x[#vi]);
+                let e = index[&(i, k)];
+                let mut items: Vec<Choice> = source(i, k)
+                    .map(|a| Choice::one(false, a))
+                    .into_iter()
+                    .collect();
+                for &j in &terms[&i] {
+                    // In a multiplier's column the coordinates' terms add (S), the
+                    // multipliers' subtract.
+                    let negative = !multiplier || self.order[j] >= n;
+                    items.push(Choice::of(
+                        negative,
+                        term(i, j, (&w_at, &l_at, &d_at, &r_at)),
+                    ));
+                }
+                let w = Choice::sum(items);
+                w_at[e] = w.ready;
+                l_at[e] = w.ready.max(r_at[k]) + MUL;
+                let (wn, ln, wc) = (name("w", e), name("l", e), w.code);
+                code.extend(quote! {
+                    let #wn = #wc;
+                    let #ln = #wn * #rn;
+                });
             }
-            code.extend(quote!(x[#v] = #e;));
+        }
+        // The back substitution, from the last position: s_k = z_k − Σ l_ik x_i, with
+        // s = −λ in the multipliers (x_i = −s_i there).
+        let s_op = |k: usize, s_at: &[u32]| Operand::new(name("s", k).into_token_stream(), s_at[k]);
+        let z_op = |k: usize| Operand::new(name("z", k).into_token_stream(), z_at[k]);
+        for k in (0..dim).rev() {
+            let mut items = vec![(false, z_op(k))];
+            match &inverse {
+                Some(inverse) if k >= n => {
+                    // s_k = z_k − Σ_p Y_pk z_p.
+                    for p in k + 1..dim {
+                        if inverse.contains_key(&(p, k)) {
+                            let t = Operand::new(t_name(p, k).into_token_stream(), t_at[&(p, k)]);
+                            items.push((true, Operand::product(vec![t, z_op(p)])));
+                        }
+                    }
+                }
+                _ => {
+                    for &i in &self.columns[k] {
+                        let negative = self.order[i] < n || k >= n;
+                        let p = Operand::product(vec![ell(i, k, &l_at), s_op(i, &s_at)]);
+                        items.push((negative, p));
+                    }
+                }
+            }
+            let s = Operand::sum(items);
+            s_at[k] = s.ready;
+            let (sn, sc) = (name("s", k), s.code);
+            code.extend(quote!(let #sn = #sc;));
+        }
+        for k in 0..dim {
+            let (x, sn) = (lit(self.order[k]), name("s", k));
+            code.extend(if k < n {
+                quote!(x[#x] = #sn;)
+            } else {
+                quote!(x[#x] = -#sn;)
+            });
         }
         let dl = lit(dim);
-        // The arrays of L D (`w`) and L (`l`) by entry, the inverse pivots (`r`) by
-        // position; slices cut to their lengths so that the indices need no checks.
-        let factors = if index.is_empty() {
-            TokenStream::new()
-        } else {
-            let nl = lit(index.len());
-            quote! {
-                let mut w = [0.0_f64; #nl];
-                let mut l = [0.0_f64; #nl];
-            }
-        };
         let count = |f: fn(&Source) -> Option<usize>| {
             self.entries
                 .values()
@@ -487,11 +656,198 @@ impl Plan {
                 #cq_cut
                 #g_cut
                 let x = &mut x[..#dl];
-                #factors
-                let mut r = [0.0_f64; #dl];
                 #code
                 ::pfaff::__private::AugmentedSolve::Solved
             }
+        }
+    }
+}
+
+/// Latency in cycles of an addition or subtraction, in the model the emitted code is
+/// ordered by ([`Plan::emit`]).
+pub const ADD: u32 = 4;
+/// Latency of a multiplication.
+pub const MUL: u32 = 4;
+/// Latency of a division.
+pub const DIV: u32 = 14;
+/// Latency of a negation.
+pub const NEG: u32 = 1;
+
+/// A term of a sum in two forms: `cheap` (fewer operations) and `fast` (ready earlier,
+/// one multiplication more); [`Choice::sum`] takes the fast form only where that makes
+/// the sum ready earlier.
+struct Choice {
+    negative: bool,
+    cheap: Operand,
+    fast: Option<Operand>,
+}
+
+impl Choice {
+    fn one(negative: bool, o: Operand) -> Choice {
+        Choice {
+            negative,
+            cheap: o,
+            fast: None,
+        }
+    }
+
+    fn of(negative: bool, (cheap, fast): (Operand, Operand)) -> Choice {
+        let fast = (fast.ready < cheap.ready).then_some(fast);
+        Choice {
+            negative,
+            cheap,
+            fast,
+        }
+    }
+
+    /// The sum, the fast forms taken for the terms ready last, as many as make it
+    /// ready earliest (the fewest of equal times).
+    fn sum(items: Vec<Choice>) -> Operand {
+        let ready = |fast: &dyn Fn(&Choice) -> bool| {
+            let times = items.iter().map(|c| match &c.fast {
+                Some(f) if fast(c) => f.ready,
+                _ => c.cheap.ready,
+            });
+            tree_time(times.collect())
+        };
+        let mut cuts: Vec<u32> = items
+            .iter()
+            .filter(|c| c.fast.is_some())
+            .map(|c| c.cheap.ready)
+            .collect();
+        cuts.sort_unstable();
+        cuts.dedup();
+        // Fast from `cut` on (cheap.ready >= cut); u32::MAX: none.
+        let mut best = (ready(&|_| false), u32::MAX);
+        for &cut in cuts.iter().rev() {
+            let t = ready(&|c: &Choice| c.cheap.ready >= cut);
+            if t < best.0 {
+                best = (t, cut);
+            }
+        }
+        let cut = best.1;
+        Operand::sum(
+            items
+                .into_iter()
+                .map(|c| match c.fast {
+                    Some(f) if c.cheap.ready >= cut => (c.negative, f),
+                    _ => (c.negative, c.cheap),
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The time of a sum of operands ready at `times`, combined two earliest first.
+fn tree_time(mut times: Vec<u32>) -> u32 {
+    while times.len() > 1 {
+        times.sort_unstable();
+        let t = times[0].max(times[1]) + ADD;
+        times.splice(0..2, [t]);
+    }
+    times.first().copied().unwrap_or(0)
+}
+
+/// A value of the emitted code: its expression and when it is ready.
+#[derive(Clone, Debug)]
+struct Operand {
+    code: TokenStream,
+    ready: u32,
+    /// An unparenthesized sum (parenthesized where it is a right operand).
+    sum: bool,
+}
+
+impl Operand {
+    fn new(code: TokenStream, ready: u32) -> Operand {
+        Operand {
+            code,
+            ready,
+            sum: false,
+        }
+    }
+
+    /// The one ready first (`a` on a tie).
+    fn earlier(a: Operand, b: Operand) -> Operand {
+        if b.ready < a.ready {
+            b
+        } else {
+            a
+        }
+    }
+
+    /// The product of the factors, the earliest ready first.
+    fn product(mut factors: Vec<Operand>) -> Operand {
+        factors.sort_by_key(|f| f.ready);
+        let mut it = factors.into_iter();
+        let mut acc = it.next().expect("a factor");
+        for f in it {
+            let (a, b) = (&acc.code, &f.code);
+            acc = Operand::new(quote!(#a * #b), acc.ready.max(f.ready) + MUL);
+        }
+        acc
+    }
+
+    /// The sum of the items (`true`: subtracted) as a tree, the two operands ready
+    /// first combined first; its sign carried until a positive operand absorbs it.
+    fn sum(items: Vec<(bool, Operand)>) -> Operand {
+        let mut pool: Vec<(bool, Operand)> = items;
+        assert!(!pool.is_empty(), "a sum of something");
+        while pool.len() > 1 {
+            // The two earliest (the first of equals: a deterministic tree).
+            let first = (0..pool.len())
+                .min_by_key(|&i| pool[i].1.ready)
+                .expect("two");
+            let (na, a) = pool.remove(first);
+            let second = (0..pool.len())
+                .min_by_key(|&i| pool[i].1.ready)
+                .expect("one");
+            let (nb, b) = pool.remove(second);
+            let ready = a.ready.max(b.ready) + ADD;
+            let paren = |o: &Operand| {
+                let c = &o.code;
+                if o.sum {
+                    quote!((#c))
+                } else {
+                    c.clone()
+                }
+            };
+            let (negative, code) = match (na, nb) {
+                (false, false) => {
+                    let (ac, bc) = (&a.code, paren(&b));
+                    (false, quote!(#ac + #bc))
+                }
+                (false, true) => {
+                    let (ac, bc) = (&a.code, paren(&b));
+                    (false, quote!(#ac - #bc))
+                }
+                (true, false) => {
+                    let (bc, ac) = (&b.code, paren(&a));
+                    (false, quote!(#bc - #ac))
+                }
+                (true, true) => {
+                    let (ac, bc) = (&a.code, paren(&b));
+                    (true, quote!(#ac + #bc))
+                }
+            };
+            pool.insert(
+                first.min(pool.len()),
+                (
+                    negative,
+                    Operand {
+                        code,
+                        ready,
+                        sum: true,
+                    },
+                ),
+            );
+        }
+        let (negative, o) = pool.pop().expect("the sum");
+        if negative {
+            let c = &o.code;
+            let c = if o.sum { quote!((#c)) } else { c.clone() };
+            Operand::new(quote!(-#c), o.ready + NEG)
+        } else {
+            o
         }
     }
 }
