@@ -335,13 +335,15 @@ impl Info {
 }
 
 /// Where [`Mechanism::dynamics_terms`] writes: every quantity the index-1 equations
-/// $[M\ J^\mathsf{T}; J\ 0][\ddot q; \lambda] = [Q; \gamma]$ need at one point, and the
-/// constraints $C$ there, each in the layout of its own function.
+/// $[M\ J^\mathsf{T}; J\ 0][\ddot q; \lambda] = [Q; \gamma]$ need at one point, and,
+/// when asked for, the constraints $C$ there, each in the layout of its own function.
 #[derive(Debug)]
 pub struct DynamicsTerms<'a> {
-    /// `C` (length `m_h`), as [`Mechanism::holonomic`]: what the projections and the
-    /// monitors read at the point, for a few operations on the sines already there.
-    pub holonomic: &'a mut [f64],
+    /// Where to write `C` (length `m_h`), as [`Mechanism::holonomic`], or `None` not to
+    /// compute it. A caller that reads $C$ at every point (Baumgarte's shift) gets it
+    /// for a few operations on the sines already there; one that does not asks for
+    /// nothing, and the generated code skips every operation only `C` needs.
+    pub holonomic: Option<&'a mut [f64]>,
     /// Values of [`Info::mass_pattern`].
     pub mass: &'a mut [f64],
     /// `Q` (length `n`), as [`Mechanism::forces`].
@@ -508,9 +510,12 @@ pub trait Mechanism {
 
     /// Everything the index-1 equations need at `(t, q, q̇)` in one call, so that the
     /// generated code computes what the quantities share (the sines of the same angles,
-    /// the same lengths) once. The default calls the separate functions.
+    /// the same lengths) once; `C` only when `out.holonomic` asks for it. The default
+    /// calls the separate functions.
     fn dynamics_terms(&self, t: f64, q: &[f64], qd: &[f64], out: DynamicsTerms<'_>) {
-        self.holonomic(t, q, out.holonomic);
+        if let Some(c) = out.holonomic {
+            self.holonomic(t, q, c);
+        }
         self.mass_matrix(t, q, out.mass);
         self.forces(t, q, qd, out.forces);
         self.holonomic_jacobian(t, q, out.holonomic_jacobian);
@@ -522,7 +527,7 @@ pub trait Mechanism {
     /// [`dynamics_terms`](Self::dynamics_terms) with the velocities corrected in
     /// between: writes `C_q` and `G` at `(t, q)`, calls `correct(cq, g, qd)` (which may
     /// change `qd`), then writes `M`, `Q`, `γ_h` and `γ_nh` at the corrected `qd` (and
-    /// `C` at `(t, q)`).
+    /// `C` at `(t, q)` when `out.holonomic` asks for it).
     /// Coordinate partitioning projects the velocities onto the constraints at the
     /// point with `C_q` and `G` this way, so that the generated code computes what the
     /// two parts share (the sines of the same angles) once. The default evaluates the

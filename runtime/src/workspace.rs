@@ -356,12 +356,16 @@ impl Workspace {
         self.info
     }
 
-    /// The output slices of the fused evaluation, and the rates $C_t$, $g$ beside them
-    /// (read by the correction of [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected)).
-    fn dynamics_outputs(&mut self) -> (crate::DynamicsTerms<'_>, (&[f64], &[f64])) {
+    /// The output slices of the fused evaluation ($C$ only when `constraints`), and the
+    /// rates $C_t$, $g$ beside them (read by the correction of
+    /// [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected)).
+    fn dynamics_outputs(
+        &mut self,
+        constraints: bool,
+    ) -> (crate::DynamicsTerms<'_>, (&[f64], &[f64])) {
         let (gamma_h, gamma_nh) = self.gamma.split_at_mut(self.info.nh());
         let terms = crate::DynamicsTerms {
-            holonomic: &mut self.c,
+            holonomic: constraints.then_some(&mut self.c[..]),
             mass: &mut self.mass_values,
             forces: &mut self.forces,
             holonomic_jacobian: &mut self.cq_values,
@@ -569,7 +573,7 @@ impl Workspace {
     /// Evaluates, in one call of the model's fused
     /// [`dynamics_terms`](Mechanism::dynamics_terms), the pattern values of $M$, $C_q$
     /// and $G$, the forces $Q$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (the dense $J$ is
-    /// not scattered).
+    /// not scattered; $C$ is not evaluated).
     pub fn eval_dynamics_terms<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -577,8 +581,22 @@ impl Workspace {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(), EvalError> {
+        self.eval_dynamics_terms_with(mech, t, q, qd, false)
+    }
+
+    /// [`eval_dynamics_terms`](Self::eval_dynamics_terms), and $C$ from the same call
+    /// when `constraints` ([`constraints`](Self::constraints); its finiteness is left
+    /// to the caller). Without it, the $C$ held here is not written.
+    pub fn eval_dynamics_terms_with<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        constraints: bool,
+    ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let (terms, _) = self.dynamics_outputs();
+        let (terms, _) = self.dynamics_outputs(constraints);
         mech.dynamics_terms(t, q, qd, terms);
         self.check_dynamics_terms(t)
     }
@@ -587,6 +605,8 @@ impl Workspace {
     /// [`Mechanism::dynamics_terms_corrected`]: `correct(cq, g, ct, bias, qd)` may change
     /// `qd` between the position terms and the velocity terms; the rates $C_t$, $g$ it
     /// reads must have been evaluated at `(t, q)` ([`eval_rates`](Self::eval_rates)).
+    /// $C$ at `(t, q)` too when `constraints`, as in
+    /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with).
     // A callback with the slices it reads and the velocities it corrects.
     #[allow(clippy::type_complexity)]
     pub fn eval_dynamics_terms_corrected<M: Mechanism + ?Sized>(
@@ -595,10 +615,11 @@ impl Workspace {
         t: f64,
         q: &[f64],
         qd: &mut [f64],
+        constraints: bool,
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let (terms, (ct, bias)) = self.dynamics_outputs();
+        let (terms, (ct, bias)) = self.dynamics_outputs(constraints);
         mech.dynamics_terms_corrected(t, q, qd, terms, &mut |cq, g, qd| {
             correct(cq, g, ct, bias, qd);
         });
@@ -760,7 +781,7 @@ mod tests {
                 out.holonomic_gamma,
                 out.nonholonomic_matrix,
                 out.nonholonomic_gamma,
-                out.holonomic,
+                out.holonomic.unwrap_or_default(),
             ];
             let (which, entry) = self.poison.get();
             for (k, x) in outputs.into_iter().enumerate() {

@@ -1,10 +1,12 @@
 //! One right-hand side of each formulation next to the generated functions it calls,
 //! in one run, per model:
 //!
-//! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C$,
-//!   $C_q$, $\gamma$, $G$) and one of `holonomic` ($C$): what every formulation
+//! - `generated`: one call of the model's fused `dynamics_terms` ($M$, $Q$, $C_q$,
+//!   $\gamma$, $G$, without $C$) and one of `holonomic` ($C$): what every formulation
 //!   evaluates at least once per right-hand side (partitioning's correction evaluates
 //!   $C$ at the predicted positions, the terms at the corrected ones);
+//! - `terms`, `terms+C`: one call of `dynamics_terms` without $C$ and with it: what
+//!   asking for $C$ (Baumgarte's shift, the projections after Adams) adds;
 //! - `generated+solve`: `dynamics_terms` and the model's generated `augmented_solve`
 //!   ($\ddot q$ and $\lambda$ from $M$, $Q$, $J$, $\gamma$): the index-1 right-hand
 //!   side in generated code alone, the floor of every formulation's;
@@ -89,7 +91,7 @@ fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
-                    holonomic: &mut constraints,
+                    holonomic: None,
                     mass: &mut mass,
                     forces: &mut forces,
                     holonomic_jacobian: &mut cq,
@@ -102,6 +104,42 @@ fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[
             black_box((&mass, &forces, &constraints, &cq));
         });
     });
+}
+
+/// `{name}/terms` and `{name}/terms+C`: one call of `dynamics_terms` without and with
+/// $C$ asked for, side by side: what $C$ adds to the fused call.
+fn terms(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut forces = vec![0.0; n];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut gamma = vec![0.0; mh + mnh];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut constraints = vec![0.0; mh];
+    for with_c in [false, true] {
+        let label = if with_c { "terms+C" } else { "terms" };
+        c.bench_function(&format!("{name}/{label}"), |b| {
+            b.iter(|| {
+                let (gh, gnh) = gamma.split_at_mut(mh);
+                model.dynamics_terms(
+                    black_box(t),
+                    black_box(q),
+                    black_box(qd),
+                    DynamicsTerms {
+                        holonomic: with_c.then_some(&mut constraints[..]),
+                        mass: &mut mass,
+                        forces: &mut forces,
+                        holonomic_jacobian: &mut cq,
+                        holonomic_gamma: gh,
+                        nonholonomic_matrix: &mut g,
+                        nonholonomic_gamma: gnh,
+                    },
+                );
+                black_box((&mass, &forces, &constraints, &cq));
+            });
+        });
+    }
 }
 
 fn generated_solve(
@@ -118,7 +156,6 @@ fn generated_solve(
     let mut cq = vec![0.0; info.holonomic_pattern.len()];
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut x = vec![0.0; n + mh + mnh];
-    let mut constraints = vec![0.0; mh];
     // Above the generator's budget (`chain100`) there is no generated solve: its
     // formulations take the sparse LU, measured below.
     if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable {
@@ -134,7 +171,7 @@ fn generated_solve(
                 black_box(q),
                 black_box(qd),
                 DynamicsTerms {
-                    holonomic: &mut constraints,
+                    holonomic: None,
                     mass: &mut mass,
                     forces,
                     holonomic_jacobian: &mut cq,
@@ -155,6 +192,7 @@ fn rhs(c: &mut Criterion) {
         let model = make();
         let (q, qd) = moving_state(model.as_ref(), t);
         generated(c, name, model.as_ref(), t, &q, &qd);
+        terms(c, name, model.as_ref(), t, &q, &qd);
         generated_solve(c, name, model.as_ref(), t, &q, &qd);
         let n = q.len();
         // The general path as before the generated solve: dense LU below the

@@ -261,6 +261,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         chart_tolerances(sim.method, sim.rtol, sim.atol),
     )
     .map_err(|e| empty(SimErrorKind::Analysis(e)))?;
+    // Adams evaluates about twice per step, last at the state it keeps, where the
+    // projections read C next: C with the terms there costs less than a call of its
+    // own per step. The explicit pairs evaluate 6 to 16 times per step, Radau5 at its
+    // stages: C at each costs more than the one call it saves (ARCHITECTURE.md).
+    sys.point.constraints_with_terms = matches!(sim.method, Method::Adams);
     let pq: Vec<(&str, f64)> = sim
         .prescribed_q
         .iter()

@@ -462,8 +462,8 @@ impl Form for Stabilized {
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
-        // The fused terms first: the shift's C_q comes with them.
-        p.dynamics_terms(t)?;
+        // The fused terms first: the shift's C and C_q come with them.
+        p.dynamics_terms_and_constraints(t)?;
         p.baumgarte_shift(t, self.alpha, self.beta, &mut self.shift)
             .map_err(SimErrorKind::from_eval)?;
         p.accelerations(t, Some(&self.shift))

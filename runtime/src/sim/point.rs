@@ -152,6 +152,13 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// (see [`constraints`](Self::constraints)): $J$ was asked for after $C$ at the
     /// last point $C$ was evaluated at.
     paired: bool,
+    /// Whether every evaluation of the dynamics terms asks for $C$ at the point too
+    /// (when not held): set for an integrator whose last evaluation of a step is at
+    /// the state the step keeps (Adams' final evaluation), where the position group
+    /// of the projections reads $C$ next, for a few operations on the sines the terms
+    /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
+    /// dynamics terms only where it is read").
+    pub constraints_with_terms: bool,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
     /// in one fused call (read by the tests).
     #[cfg_attr(not(test), allow(dead_code))]
@@ -203,6 +210,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             newton_iterations: 0,
             factorizations: 0,
             redundant: Vec::new(),
+            constraints_with_terms: false,
         };
         point.plan_grams();
         Ok(point)
@@ -488,7 +496,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.solved == state {
             return Ok(());
         }
-        self.dynamics_terms_at(t, (position, state))?;
+        self.dynamics_terms_at(t, (position, state), self.constraints_with_terms)?;
         self.factorizations += 1;
         let stats = self
             .dynamics
@@ -508,30 +516,51 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
-    /// model's fused evaluation (which gives $C$, $C_q$ and $G$ to the position groups
-    /// too).
+    /// model's fused evaluation (which gives $C_q$ and $G$ to the position group too,
+    /// and $C$ when [`constraints_with_terms`](Self::constraints_with_terms)).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
-        self.dynamics_terms_at(t, versions)
+        self.dynamics_terms_at(t, versions, self.constraints_with_terms)
+    }
+
+    /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
+    /// the same call when neither is held (the generated code computes $C$ from the
+    /// sines it already has), [`constraints`](Self::constraints) when the terms are.
+    /// For callers that read $C$ at every point (Baumgarte's shift).
+    pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        let versions = self.versions(t);
+        self.dynamics_terms_at(t, versions, true)?;
+        if self.constraints != versions.0 {
+            self.constraints(t).map_err(SimErrorKind::from_eval)?;
+        }
+        Ok(())
     }
 
     /// [`dynamics_terms`](Self::dynamics_terms) at the current state, of versions
-    /// `(position, state)`.
+    /// `(position, state)`, asking for $C$ too when `constraints` and $C$ is not held
+    /// at the position. Without it the workspace's $C$ is not written, so its stamp
+    /// stays true.
     #[inline]
     fn dynamics_terms_at(
         &mut self,
         t: f64,
         (position, state): (Stamp, Stamp),
+        constraints: bool,
     ) -> Result<(), SimErrorKind> {
         if self.terms != state {
+            let with_c = constraints && self.constraints != position;
             self.jacobian = 0;
-            self.constraints = 0;
+            if with_c {
+                self.constraints = 0;
+            }
             self.ws
-                .eval_dynamics_terms(self.mech, t, &self.q, &self.qd)
+                .eval_dynamics_terms_with(self.mech, t, &self.q, &self.qd, with_c)
                 .map_err(SimErrorKind::from_eval)?;
             self.terms = state;
             self.jacobian = position;
-            self.stamp_terms_constraints(position);
+            if with_c {
+                self.stamp_terms_constraints(position);
+            }
         }
         Ok(())
     }
@@ -561,16 +590,27 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
         }
+        let with_c = self.constraints_with_terms && self.constraints != at;
         self.jacobian = 0;
-        self.constraints = 0;
         self.terms = 0;
-        self.ws
-            .eval_dynamics_terms_corrected(self.mech, t, &self.q, &mut self.qd, correct)?;
+        if with_c {
+            self.constraints = 0;
+        }
+        self.ws.eval_dynamics_terms_corrected(
+            self.mech,
+            t,
+            &self.q,
+            &mut self.qd,
+            with_c,
+            correct,
+        )?;
         // The velocities may have changed: a new state version, the same position.
         let (position, state) = self.versions(t);
         self.terms = state;
         self.jacobian = position;
-        self.stamp_terms_constraints(position);
+        if with_c {
+            self.stamp_terms_constraints(position);
+        }
         Ok(())
     }
 
@@ -939,5 +979,52 @@ mod tests {
         p.dense_jacobian(0.0).expect("J");
         assert_eq!(counts(&p), (5, 1, 3));
         assert_eq!(p.ws.constraints()[0], 0.95 * 0.95 + 0.3 * 0.3 - 1.0);
+    }
+
+    /// $C$ comes with the dynamics terms only when asked for, and is never stale: terms
+    /// evaluated without it leave the $C$ held at another point to be evaluated anew
+    /// where it is read; with [`Point::constraints_with_terms`] (and for Baumgarte's
+    /// [`Point::dynamics_terms_and_constraints`]) the terms' call writes it, and reading
+    /// it at the same point evaluates nothing more. Values against the closed form
+    /// $x^2 + y^2 - 1$.
+    #[test]
+    fn constraints_come_with_the_terms_only_when_asked_for() {
+        let mech = Circle;
+        let mut p = Point::new(
+            &mech,
+            DynamicsParams::default(),
+            KinematicsParams::default(),
+        )
+        .expect("a point");
+        let circle = |p: &Point<'_, Circle>| p.q[0] * p.q[0] + p.q[1] * p.q[1] - 1.0;
+        p.set_state(&[1.2, 0.1, 0.3, -0.2]);
+        p.constraints(0.0).expect("C");
+        assert_eq!(counts(&p), (1, 0, 0));
+        // Terms at a new point without C: C there is evaluated when read.
+        p.q[0] = 1.1;
+        p.dynamics_terms(0.0).expect("terms");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        // Asked for with every evaluation of the terms: read at no further cost.
+        p.constraints_with_terms = true;
+        p.q[1] = 0.2;
+        p.dynamics_terms(0.0).expect("terms");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        // Baumgarte's request, at a new point and then with the terms held.
+        p.constraints_with_terms = false;
+        p.q[0] = 1.05;
+        p.dynamics_terms_and_constraints(0.0).expect("terms and C");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (2, 0, 0));
+        p.q[1] = 0.25;
+        p.dynamics_terms(0.0).expect("terms");
+        p.dynamics_terms_and_constraints(0.0).expect("C alone");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (3, 0, 0));
     }
 }

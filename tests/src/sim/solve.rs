@@ -53,13 +53,12 @@ fn multiplier_scale(model: &dyn Mechanism, q: &[f64], qd: &[f64]) -> f64 {
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut gamma = vec![0.0; mh + mnh];
     let (gh, gnh) = gamma.split_at_mut(mh);
-    let mut c = vec![0.0; mh];
     model.dynamics_terms(
         0.3,
         q,
         qd,
         DynamicsTerms {
-            holonomic: &mut c,
+            holonomic: None,
             mass: &mut mass,
             forces: &mut forces,
             holonomic_jacobian: &mut cq,
@@ -199,13 +198,12 @@ fn a_massless_coordinate_takes_the_general_path() {
         let mut cq = vec![0.0; info.holonomic_pattern.len()];
         let mut b = vec![0.0; n + mh];
         let (forces, gamma) = b.split_at_mut(n);
-        let mut c = vec![0.0; mh];
         model.dynamics_terms(
             0.3,
             &q,
             &qd,
             DynamicsTerms {
-                holonomic: &mut c,
+                holonomic: None,
                 mass: &mut mass,
                 forces,
                 holonomic_jacobian: &mut cq,
@@ -259,8 +257,9 @@ fn every_built_in_model_agrees_with_the_dense_path() {
 }
 
 /// The terms of one `dynamics_terms` call at `(q, qd)`, concatenated in the order of
-/// [`DynamicsTerms`]' fields.
-fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+/// [`DynamicsTerms`]' fields: with `C` first when `with_c`, without it (not asked for)
+/// otherwise.
+fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64], with_c: bool) -> Vec<f64> {
     let info = model.info();
     let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
     let mut mass = vec![0.0; info.mass_pattern.len()];
@@ -269,13 +268,13 @@ fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
     let mut gh = vec![0.0; mh];
     let mut g = vec![0.0; info.nonholonomic_pattern.len()];
     let mut gnh = vec![0.0; mnh];
-    let mut c = vec![0.0; mh];
+    let mut c = vec![0.0; if with_c { mh } else { 0 }];
     model.dynamics_terms(
         t,
         q,
         qd,
         DynamicsTerms {
-            holonomic: &mut c,
+            holonomic: with_c.then_some(&mut c[..]),
             mass: &mut mass,
             forces: &mut forces,
             holonomic_jacobian: &mut cq,
@@ -287,13 +286,123 @@ fn terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
     [c, mass, forces, cq, gh, g, gnh].concat()
 }
 
+/// The separate functions' values in the order of [`terms`] with `C`.
+fn separate_terms(model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) -> Vec<Vec<f64>> {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut c = vec![0.0; mh];
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut forces = vec![0.0; n];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut gh = vec![0.0; mh];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut gnh = vec![0.0; mnh];
+    model.holonomic(t, q, &mut c);
+    model.mass_matrix(t, q, &mut mass);
+    model.forces(t, q, qd, &mut forces);
+    model.holonomic_jacobian(t, q, &mut cq);
+    model.holonomic_gamma(t, q, qd, &mut gh);
+    model.nonholonomic_matrix(t, q, &mut g);
+    model.nonholonomic_gamma(t, q, qd, &mut gnh);
+    vec![c, mass, forces, cq, gh, g, gnh]
+}
+
+/// `dynamics_terms` (one schedule for every term, generated for every model) writes
+/// what the separate functions write, with `C` asked for or not, on seeded random
+/// states of every built-in model: the same expressions with their temporaries shared,
+/// so equal up to rounding (a sine alone and one of `sin_cos` may differ in the last
+/// bit), within 10⁻¹⁴ of each quantity's size (`max(1, ‖·‖∞)`; for `C`, of
+/// (1 + ‖q‖∞) ‖C_q‖∞ as in `constraints_with_jacobian_equal_the_separate_functions`).
+/// Without `C` the other terms are the same to the bit (the statements only `C` needs
+/// are skipped, nothing else changes), and the fused `C_q` matches central differences
+/// of the fused `C` (step `1e-6 (1 + |q_j|)`, within 10⁻⁵ ‖C_q‖∞, the tolerance of
+/// `bodies/joints.rs`, where the separate functions are checked against differences).
+#[test]
+fn terms_equal_the_separate_functions_with_and_without_constraints() {
+    let mut checked = 0;
+    for (k, entry) in pfaff_models::all().iter().enumerate() {
+        let model = (entry.make)();
+        let info = model.info();
+        let (n, mh) = (info.nq(), info.nh());
+        let name = entry.name;
+        for (j, (q, qd)) in states(model.as_ref(), 3, 60 + k as u64)
+            .into_iter()
+            .enumerate()
+        {
+            #[allow(clippy::cast_precision_loss)]
+            let t = 0.1 * j as f64;
+            let with = terms(model.as_ref(), t, &q, &qd, true);
+            let without = terms(model.as_ref(), t, &q, &qd, false);
+            assert!(
+                with[mh..]
+                    .iter()
+                    .zip(&without)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+                    && with.len() == mh + without.len(),
+                "{name}: the terms depend on whether C is asked for"
+            );
+            let separate = separate_terms(model.as_ref(), t, &q, &qd);
+            let cq_size = separate[3].iter().fold(1.0_f64, |s, v| s.max(v.abs()));
+            let reach = 1.0 + q.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+            let mut at = 0;
+            for (i, part) in separate.iter().enumerate() {
+                let got = &with[at..at + part.len()];
+                at += part.len();
+                let size = if i == 0 {
+                    reach * cq_size
+                } else {
+                    part.iter().fold(1.0_f64, |s, v| s.max(v.abs()))
+                };
+                let e = got
+                    .iter()
+                    .zip(part)
+                    .fold(0.0_f64, |e, (x, y)| e.max((x - y).abs()));
+                assert!(
+                    e <= 1e-14 * size,
+                    "{name}: term {i} off by {e:e} of {size:e}"
+                );
+            }
+            // The fused C_q against central differences of the fused C.
+            let mut dense = vec![0.0; mh * n];
+            let offset = mh + info.mass_pattern.len() + n;
+            for (&(r, col), v) in info
+                .holonomic_pattern
+                .iter()
+                .zip(&with[offset..offset + info.holonomic_pattern.len()])
+            {
+                dense[r as usize * n + col as usize] = *v;
+            }
+            let mut qh = q.clone();
+            for col in 0..n {
+                let h = 1e-6 * (1.0 + q[col].abs());
+                qh[col] = q[col] + h;
+                let cp = terms(model.as_ref(), t, &qh, &qd, true);
+                qh[col] = q[col] - h;
+                let cm = terms(model.as_ref(), t, &qh, &qd, true);
+                qh[col] = q[col];
+                for r in 0..mh {
+                    let fd = (cp[r] - cm[r]) / (2.0 * h);
+                    let e = (fd - dense[r * n + col]).abs();
+                    assert!(
+                        e <= 1e-5 * cq_size,
+                        "{name}: C_q[{r}][{col}] = {} against {fd} by differences",
+                        dense[r * n + col]
+                    );
+                }
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 20, "only {checked} models");
+}
+
 /// `dynamics_terms_corrected` (generated for models with constraint rows, the trait's
 /// default otherwise) hands the correction `C_q` and `G` at `q` (equal to
 /// `holonomic_jacobian` and `nonholonomic_matrix`) and writes every term at the
 /// velocities as the correction left them: equal to `dynamics_terms` there, on seeded
 /// random states of models with angles, lengths, driven coordinates (slider_crank),
 /// non-holonomic rows (sleigh, rolling_disk, bicycle) and run-time data
-/// (flexible_crank).
+/// (flexible_crank), with `C` asked for (then equal to `C` of `dynamics_terms`) and not.
 #[test]
 fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
     for (name, seed) in [
@@ -310,9 +419,11 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
         let model = (pfaff_models::find(name).expect("a built-in model").make)();
         let info = model.info();
         let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
-        for (k, (q, qd)) in states(model.as_ref(), 5, seed).into_iter().enumerate() {
+        for (k, (q, qd)) in states(model.as_ref(), 6, seed).into_iter().enumerate() {
             #[allow(clippy::cast_precision_loss)]
             let t = 0.1 * k as f64;
+            // C asked for on every other state.
+            let with_c = k % 2 == 1;
             let mut cq = vec![0.0; info.holonomic_pattern.len()];
             let mut g = vec![0.0; info.nonholonomic_pattern.len()];
             model.holonomic_jacobian(t, &q, &mut cq);
@@ -323,7 +434,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
             let mut gh = vec![0.0; mh];
             let mut g_out = vec![0.0; g.len()];
             let mut gnh = vec![0.0; mnh];
-            let mut c_out = vec![0.0; mh];
+            let mut c_out = vec![0.0; if with_c { mh } else { 0 }];
             let mut corrected = qd.clone();
             let mut seen = None;
             model.dynamics_terms_corrected(
@@ -331,7 +442,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
                 &q,
                 &mut corrected,
                 DynamicsTerms {
-                    holonomic: &mut c_out,
+                    holonomic: with_c.then_some(&mut c_out[..]),
                     mass: &mut out,
                     forces: &mut forces,
                     holonomic_jacobian: &mut cq_out,
@@ -355,7 +466,7 @@ fn corrected_terms_equal_the_terms_at_the_corrected_velocities() {
             assert!(relative(&c, &cq, 1.0) <= 1e-14, "{name}: C_q handed over");
             assert!(relative(&gm, &g, 1.0) <= 1e-14, "{name}: G handed over");
             assert_ne!(corrected, qd, "{name}: the velocities were changed");
-            let expected = terms(model.as_ref(), t, &q, &corrected);
+            let expected = terms(model.as_ref(), t, &q, &corrected, with_c);
             let got = [c_out, out, forces, cq_out, gh, g_out, gnh].concat();
             let scale = expected.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
             let e = relative(&got, &expected, scale);

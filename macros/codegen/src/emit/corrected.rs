@@ -1,7 +1,7 @@
 //! `Mechanism::dynamics_terms_corrected`: the fused dynamics terms with the
 //! velocities corrected between the position terms and the velocity terms.
 //!
-//! Input: the roots of `dynamics_terms` (`M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh`). Output: one
+//! Input: the roots of `dynamics_terms` (`C`, `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh`). Output: one
 //! function whose body is the schedule of `dynamics_terms` split in two: the loads of
 //! `t`, `q`, the parameters and data, every temporary and output that does not depend on
 //! a velocity (so `C_q` and `G`, and the sines and cosines of the angles), then a call
@@ -11,13 +11,17 @@
 //! needs `M`, `Q` and `γ` at the projected velocities: in one call, what the two share
 //! is computed once (on `andrews`, the sines and cosines of `holonomic_jacobian`).
 //! Every temporary is still computed once; the split only orders them (a temporary that
-//! does not depend on `q̇` never depends on one that does).
+//! does not depend on `q̇` never depends on one that does). What only `C` needs comes
+//! last, under the same guard as in `dynamics_terms`: computed only when asked for.
 
-use proc_macro2::{Literal, TokenStream};
+use proc_macro2::{Ident, Span, TokenStream};
 use quote::quote;
 
-use super::expr::{Names, Printer};
-use super::{arg, data_slots, dynamics_roots, reads_data_inline, ModelNames, MAX_LETS};
+use super::expr::Printer;
+use super::{
+    arg, data_slots, dynamics_roots, guard_constraints, read_var, reads_data_inline, store_term,
+    ModelNames, MAX_LETS,
+};
 use crate::derive::Derived;
 use crate::sched;
 use crate::sym::{Deps, ExprId, Graph, Var};
@@ -41,6 +45,10 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
     let inline_data = reads_data_inline(&prog);
     // Which nodes depend on a velocity: the graph's dependency summary of each node.
     let moving = |id: ExprId| g.deps(id).has(Deps::QD);
+    // What only `C` needs (it depends on no velocity) goes under the guard at the end.
+    let optional = d.c.len();
+    let (needed, needed_vars) = prog.needed(g, &roots[optional..]);
+    let c = Ident::new(&names.out_c, Span::call_site());
 
     // At most MAX_LETS temporaries: each is a `let` (see `super::body`).
     let printer = Printer {
@@ -52,34 +60,26 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
     };
     let mut before = TokenStream::new();
     let mut after = TokenStream::new();
+    let mut guarded = TokenStream::new();
     for v in &prog.vars {
-        let name = names.var(*v);
-        match v {
-            Var::Time => {}
-            Var::Q(i) => {
-                let i = Literal::u32_unsuffixed(*i);
-                before.extend(quote!(let #name = q[#i];));
-            }
-            Var::Qd(i) => {
-                let i = Literal::u32_unsuffixed(*i);
-                after.extend(quote!(let #name = qd[#i];));
-            }
-            Var::Param(_) => before.extend(quote!(let #name = self.params.#name;)),
-            Var::Data(_) if inline_data => {}
-            Var::Data(i) => {
-                let (field, _, k) = names.data_entry(*i);
-                let k = Literal::usize_unsuffixed(k);
-                before.extend(quote!(let #name = self.data.#field[#k];));
-            }
-            Var::Delta(_) | Var::Input(_) => {
-                unreachable!("the dynamics terms read no variations or inputs")
-            }
+        if inline_data && matches!(v, Var::Data(_)) {
+            continue;
+        }
+        let read = read_var(names, *v);
+        if !needed_vars.contains(v) {
+            guarded.extend(read);
+        } else if matches!(v, Var::Qd(_)) {
+            after.extend(read);
+        } else {
+            before.extend(read);
         }
     }
     for (k, &id) in prog.lets.iter().enumerate() {
         // A sine–cosine pair shares its argument's dependencies: both on one side.
         let stmt = printer.define(k, id);
-        if moving(id) {
+        if !needed[id.index()] {
+            guarded.extend(stmt);
+        } else if moving(id) {
             after.extend(stmt);
         } else {
             before.extend(stmt);
@@ -87,15 +87,16 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
     }
     for (k, &r) in roots.iter().enumerate() {
         let (ts, _) = printer.expr(r, false);
-        let (field, i) = &slots[k];
-        let i = Literal::usize_unsuffixed(*i);
-        let stmt = quote!(out.#field[#i] = #ts;);
-        if moving(r) {
+        let stmt = store_term(&slots[k], &c, ts);
+        if k < optional {
+            guarded.extend(stmt);
+        } else if moving(r) {
             after.extend(stmt);
         } else {
             before.extend(stmt);
         }
     }
+    let guarded = guard_constraints(&c, guarded);
     let t = arg(&prog, "t", |v| *v == Var::Time);
     let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
     // Contractions read `qd` as a slice: after the correction, like the loads.
@@ -111,6 +112,7 @@ pub(super) fn dynamics_terms_corrected(g: &Graph, names: &ModelNames, d: &Derive
             #before
             correct(out.holonomic_jacobian, out.nonholonomic_matrix, qd);
             #after
+            #guarded
         }
     }
 }

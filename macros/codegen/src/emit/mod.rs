@@ -39,7 +39,8 @@ struct ModelNames {
     input_prefix: String,
     /// The local array of temporaries of long functions.
     temps: String,
-    /// The arguments of `holonomic_with_jacobian` receiving `C` and `C_q`.
+    /// The arguments of `holonomic_with_jacobian` receiving `C` and `C_q` (and the
+    /// binding of the `C` a caller of the dynamics terms asks for).
     out_c: String,
     out_cq: String,
     /// Per data slot: its field name, the prefix of its entries' names, its offset and
@@ -201,7 +202,8 @@ fn reads_data_inline(prog: &Program) -> bool {
 }
 
 /// The outputs of `dynamics_terms` in its order, as roots of one schedule and the
-/// `(field, index)` of `DynamicsTerms` each root is stored in.
+/// `(field, index)` of `DynamicsTerms` each root is stored in; `C`, the output the
+/// caller may leave out, first.
 fn dynamics_roots(d: &Derived) -> (Vec<ExprId>, Vec<(Ident, usize)>) {
     let parts: [(&str, Vec<ExprId>); 7] = [
         ("holonomic", d.c.clone()),
@@ -231,7 +233,23 @@ fn body(
     roots: &[ExprId],
     store: impl Fn(usize, TokenStream) -> TokenStream,
 ) -> (TokenStream, Program) {
+    let (code, _, prog) = body_split(g, names, roots, 0, store);
+    (code, prog)
+}
+
+/// [`body`] with the first `optional` roots split off: the statements the other roots
+/// need, then (second) the reads, temporaries and stores that only the optional roots
+/// need, for the caller to emit under a guard (an output the caller of the generated
+/// function may not ask for).
+fn body_split(
+    g: &Graph,
+    names: &ModelNames,
+    roots: &[ExprId],
+    optional: usize,
+    store: impl Fn(usize, TokenStream) -> TokenStream,
+) -> (TokenStream, TokenStream, Program) {
     let prog = sched::schedule_with(g, roots, &data_slots(names));
+    let (needed, needed_vars) = prog.needed(g, &roots[optional..]);
     // Every `let` opens a debug-info scope nested in the previous one; LLVM's DWARF
     // writer recurses through that chain, and ten thousand of them (a bicycle's
     // linearization Jacobian) overflow the compiler's stack. Long functions keep their
@@ -247,47 +265,67 @@ fn body(
         inline_data,
     };
     let mut out = TokenStream::new();
+    let mut guarded = TokenStream::new();
     for v in &prog.vars {
         if inline_data && matches!(v, Var::Data(_)) {
             continue;
         }
-        let name = names.var(*v);
-        out.extend(match v {
-            Var::Time => quote!(),
-            Var::Q(i) => {
-                let i = Literal::u32_unsuffixed(*i);
-                quote!(let #name = q[#i];)
-            }
-            Var::Qd(i) => {
-                let i = Literal::u32_unsuffixed(*i);
-                quote!(let #name = qd[#i];)
-            }
-            Var::Param(_) => quote!(let #name = self.params.#name;),
-            Var::Delta(_) => unreachable!("variations never reach generated code"),
-            Var::Input(i) => {
-                let inputs = Ident::new(&names.inputs, Span::call_site());
-                let i = Literal::u32_unsuffixed(*i);
-                quote!(let #name = #inputs[#i];)
-            }
-            Var::Data(i) => {
-                let (field, _, k) = names.data_entry(*i);
-                let k = Literal::usize_unsuffixed(k);
-                quote!(let #name = self.data.#field[#k];)
-            }
-        });
+        let read = read_var(names, *v);
+        if needed_vars.contains(v) {
+            out.extend(read);
+        } else {
+            guarded.extend(read);
+        }
     }
     if let Some(array) = &array {
         let len = Literal::usize_unsuffixed(prog.lets.len());
         out.extend(quote!(let mut #array = [0.0_f64; #len];));
     }
     for (k, &id) in prog.lets.iter().enumerate() {
-        out.extend(printer.define(k, id));
+        let define = printer.define(k, id);
+        if needed[id.index()] {
+            out.extend(define);
+        } else {
+            guarded.extend(define);
+        }
     }
     for (k, &r) in roots.iter().enumerate() {
         let (ts, _) = printer.expr(r, false);
-        out.extend(store(k, ts));
+        if k < optional {
+            guarded.extend(store(k, ts));
+        } else {
+            out.extend(store(k, ts));
+        }
     }
-    (out, prog)
+    (out, guarded, prog)
+}
+
+/// The statement reading variable `v` into its local.
+fn read_var(names: &ModelNames, v: Var) -> TokenStream {
+    let name = names.var(v);
+    match v {
+        Var::Time => quote!(),
+        Var::Q(i) => {
+            let i = Literal::u32_unsuffixed(i);
+            quote!(let #name = q[#i];)
+        }
+        Var::Qd(i) => {
+            let i = Literal::u32_unsuffixed(i);
+            quote!(let #name = qd[#i];)
+        }
+        Var::Param(_) => quote!(let #name = self.params.#name;),
+        Var::Delta(_) => unreachable!("variations never reach generated code"),
+        Var::Input(i) => {
+            let inputs = Ident::new(&names.inputs, Span::call_site());
+            let i = Literal::u32_unsuffixed(i);
+            quote!(let #name = #inputs[#i];)
+        }
+        Var::Data(i) => {
+            let (field, _, k) = names.data_entry(i);
+            let k = Literal::usize_unsuffixed(k);
+            quote!(let #name = self.data.#field[#k];)
+        }
+    }
 }
 
 /// The argument name for `t`, `q` or `qd`: prefixed with `_` when unused.
@@ -898,15 +936,17 @@ fn drawing(g: &Graph, names: &ModelNames, d: &crate::derive::drawing::DrawingOut
     }
 }
 
-/// `dynamics_terms`: `C`, `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh` in one schedule, so that
-/// what they share is computed once.
+/// `dynamics_terms`: `M`, `Q`, `C_q`, `γ_h`, `G`, `γ_nh`, and `C` when the caller asks
+/// for it, in one schedule, so that what they share is computed once. The reads,
+/// temporaries and stores only `C` needs are emitted under the test of
+/// `out.holonomic`: a caller that does not ask pays one branch.
 fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
     let (roots, slots) = dynamics_roots(d);
-    let (code, prog) = body(g, names, &roots, |k, ts| {
-        let (field, i) = &slots[k];
-        let i = Literal::usize_unsuffixed(*i);
-        quote!(out.#field[#i] = #ts;)
+    let c = Ident::new(&names.out_c, Span::call_site());
+    let (code, guarded, prog) = body_split(g, names, &roots, d.c.len(), |k, ts| {
+        store_term(&slots[k], &c, ts)
     });
+    let guarded = guard_constraints(&c, guarded);
     let t = arg(&prog, "t", |v| *v == Var::Time);
     let q = arg(&prog, "q", |v| matches!(v, Var::Q(_)));
     let qd = arg(&prog, "qd", |v| matches!(v, Var::Qd(_)));
@@ -915,6 +955,31 @@ fn dynamics_terms(g: &Graph, names: &ModelNames, d: &Derived) -> TokenStream {
             &self, #t: f64, #q: &[f64], #qd: &[f64], out: ::pfaff::__private::DynamicsTerms<'_>,
         ) {
             #code
+            #guarded
+        }
+    }
+}
+
+/// The statement storing output `ts` in its `(field, index)` of `DynamicsTerms`; `C`
+/// goes to `c`, the slice of the guard of [`guard_constraints`].
+fn store_term((field, i): &(Ident, usize), c: &Ident, ts: TokenStream) -> TokenStream {
+    let i = Literal::usize_unsuffixed(*i);
+    if field == "holonomic" {
+        quote!(#c[#i] = #ts;)
+    } else {
+        quote!(out.#field[#i] = #ts;)
+    }
+}
+
+/// The statements only `C` needs, run when the caller asked for `C` (nothing when
+/// there are none: a model without holonomic constraints).
+fn guard_constraints(c: &Ident, guarded: TokenStream) -> TokenStream {
+    if guarded.is_empty() {
+        return guarded;
+    }
+    quote! {
+        if let ::core::option::Option::Some(#c) = out.holonomic {
+            #guarded
         }
     }
 }

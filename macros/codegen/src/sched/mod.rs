@@ -59,6 +59,35 @@ impl Program {
     pub fn reads(&self, pred: impl Fn(&Var) -> bool) -> bool {
         self.vars.iter().chain(&self.run_vars).any(pred)
     }
+
+    /// The nodes and the variables (as leaves) that `roots`, some of this program's,
+    /// need: what a function must compute when only those outputs are asked for. A
+    /// sine needs its paired cosine and the other way round (one call defines both).
+    /// Every other node is needed only by the remaining roots.
+    pub fn needed(&self, g: &Graph, roots: &[ExprId]) -> (Vec<bool>, BTreeSet<Var>) {
+        let mut needed = vec![false; g.len()];
+        let mut vars = BTreeSet::new();
+        let mut stack = roots.to_vec();
+        while let Some(id) = stack.pop() {
+            if needed[id.index()] {
+                continue;
+            }
+            needed[id.index()] = true;
+            if let Some(&other) = self.partner.get(&id) {
+                stack.push(other);
+            }
+            match g.node(id) {
+                Node::Var(v) => {
+                    vars.insert(*v);
+                }
+                node => match self.runs.get(&id) {
+                    Some((_, rest)) => stack.extend(rest.iter().copied()),
+                    None => stack.extend(node.args()),
+                },
+            }
+        }
+        (needed, vars)
+    }
 }
 
 /// Schedules `roots` into straight-line code.
