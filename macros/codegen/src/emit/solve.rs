@@ -307,15 +307,18 @@ impl Plan {
     /// is therefore built with a model of when each value is ready (additions and
     /// multiplications [`ADD`], [`MUL`] cycles, divisions [`DIV`], the inputs at 0), and
     /// every sum is combined as a tree, the two earliest ready operands first (which
-    /// minimizes the time of the result), every product of three factors the two
-    /// earliest first. A term $l_{ij} w_{kj}$ of an update is written as
-    /// $(w_{ij} w_{kj}) r_j$ when that is ready earlier (the product of the `w` waits
-    /// for no division), the forward substitution is folded into the factorization
+    /// minimizes the time of the result; products the earliest factors first), a term
+    /// $l_{ij} w_{kj}$ of an update is written $l_{kj} w_{ij}$ when that is ready
+    /// earlier, the forward substitution is folded into the factorization
     /// (`y`, computed with the rows of $L$ as they appear), and when it is cheap enough
     /// (it adds at most half the operations of the rest, `Plan::inverse_operations`) the
     /// unit triangle of the multipliers' block is inverted alongside the factorization
     /// (its rows wait for no division), so that the multipliers are independent dot
-    /// products after the last pivot instead of a chain of `m` substitutions.
+    /// products after the last pivot instead of a chain of `m` substitutions. Writing
+    /// the terms as $(w_{ij} w_{kj}) r_j$ (the product of the `w` waits for no
+    /// division) shortens the modelled path further but was slower where measured
+    /// (one multiplication more per term: andrews and bicycle, `perf` samples in the
+    /// solve), so it is not done.
     ///
     /// Sign convention: in the multipliers' block the code holds $-w$ and $-d$ (the
     /// positive Schur complement $S = J M^{-1} J^\mathsf{T}$ and its pivots), so that
@@ -451,18 +454,16 @@ impl Plan {
                     code.extend(quote!(let #tn = #tc;));
                 }
             }
-            // A term ± l_ij w_kj of the update of entry (i, k), in its earliest form.
-            let term = |i: usize, j: usize, at: (&[u32], &[u32], &[u32], &[u32])| {
-                let (w_at, l_at, d_at, r_at) = at;
+            // A term ± l_ij w_kj of the update of entry (i, k), the earlier of l_ij w_kj and
+            // l_kj w_ij.
+            let term = |i: usize, j: usize, at: (&[u32], &[u32], &[u32])| {
+                let (w_at, l_at, d_at) = at;
                 let (vi, vk) = (v(i, j, w_at, d_at), v(k, j, w_at, d_at));
-                let r = Operand::new(name("r", j).into_token_stream(), r_at[j]);
-                let mut cheap = Operand::product(vec![ell(i, j, l_at), vk.clone()]);
+                let mut term = Operand::product(vec![ell(i, j, l_at), vk]);
                 if i != k {
-                    let other = Operand::product(vec![ell(k, j, l_at), vi.clone()]);
-                    cheap = Operand::earlier(cheap, other);
+                    term = Operand::earlier(term, Operand::product(vec![ell(k, j, l_at), vi]));
                 }
-                let fast = Operand::product(vec![vi, vk, r]);
-                (cheap, fast)
+                term
             };
             // The pivot, checked against the diagonal it started from.
             let dn = name("d", k);
@@ -474,11 +475,11 @@ impl Plan {
                     code.extend(quote!(let #an = #ac;));
                     a = Operand::new(an.into_token_stream(), a.ready);
                 }
-                let mut items = vec![Choice::one(false, a.clone())];
+                let mut items = vec![(false, a.clone())];
                 for &j in &terms[&k] {
-                    items.push(Choice::of(true, term(k, j, (&w_at, &l_at, &d_at, &r_at))));
+                    items.push((true, term(k, j, (&w_at, &l_at, &d_at))));
                 }
-                let d = Choice::sum(items);
+                let d = Operand::sum(items);
                 d_at[k] = d.ready;
                 let (dc, ac) = (d.code, a.code);
                 code.extend(quote! {
@@ -494,12 +495,12 @@ impl Plan {
                     terms[&k].iter().partition(|&&j| self.order[j] < n);
                 let items = coordinates
                     .iter()
-                    .map(|&j| Choice::of(false, term(k, j, (&w_at, &l_at, &d_at, &r_at))))
+                    .map(|&j| (false, term(k, j, (&w_at, &l_at, &d_at))))
                     .collect::<Vec<_>>();
                 let s = if items.is_empty() {
                     Operand::new(quote!(0.0), 0)
                 } else {
-                    Choice::sum(items)
+                    Operand::sum(items)
                 };
                 let (cn, sc) = (name("c", k), s.code);
                 code.extend(quote!(let #cn = #sc;));
@@ -513,11 +514,11 @@ impl Plan {
                         }
                     });
                 } else {
-                    let mut items = vec![Choice::one(false, c)];
+                    let mut items = vec![(false, c)];
                     for &j in &multipliers {
-                        items.push(Choice::of(true, term(k, j, (&w_at, &l_at, &d_at, &r_at))));
+                        items.push((true, term(k, j, (&w_at, &l_at, &d_at))));
                     }
-                    let d = Choice::sum(items);
+                    let d = Operand::sum(items);
                     d_at[k] = d.ready;
                     let dc = d.code;
                     code.extend(quote! {
@@ -545,20 +546,15 @@ impl Plan {
             // multipliers' rows and columns), l_ik = w_ik r_k.
             for &i in &self.columns[k] {
                 let e = index[&(i, k)];
-                let mut items: Vec<Choice> = source(i, k)
-                    .map(|a| Choice::one(false, a))
-                    .into_iter()
-                    .collect();
+                let mut items: Vec<(bool, Operand)> =
+                    source(i, k).map(|a| (false, a)).into_iter().collect();
                 for &j in &terms[&i] {
                     // In a multiplier's column the coordinates' terms add (S), the
                     // multipliers' subtract.
                     let negative = !multiplier || self.order[j] >= n;
-                    items.push(Choice::of(
-                        negative,
-                        term(i, j, (&w_at, &l_at, &d_at, &r_at)),
-                    ));
+                    items.push((negative, term(i, j, (&w_at, &l_at, &d_at))));
                 }
-                let w = Choice::sum(items);
+                let w = Operand::sum(items);
                 w_at[e] = w.ready;
                 l_at[e] = w.ready.max(r_at[k]) + MUL;
                 let (wn, ln, wc) = (name("w", e), name("l", e), w.code);
@@ -672,81 +668,6 @@ pub const MUL: u32 = 4;
 pub const DIV: u32 = 14;
 /// Latency of a negation.
 pub const NEG: u32 = 1;
-
-/// A term of a sum in two forms: `cheap` (fewer operations) and `fast` (ready earlier,
-/// one multiplication more); [`Choice::sum`] takes the fast form only where that makes
-/// the sum ready earlier.
-struct Choice {
-    negative: bool,
-    cheap: Operand,
-    fast: Option<Operand>,
-}
-
-impl Choice {
-    fn one(negative: bool, o: Operand) -> Choice {
-        Choice {
-            negative,
-            cheap: o,
-            fast: None,
-        }
-    }
-
-    fn of(negative: bool, (cheap, fast): (Operand, Operand)) -> Choice {
-        let fast = (fast.ready < cheap.ready).then_some(fast);
-        Choice {
-            negative,
-            cheap,
-            fast,
-        }
-    }
-
-    /// The sum, the fast forms taken for the terms ready last, as many as make it
-    /// ready earliest (the fewest of equal times).
-    fn sum(items: Vec<Choice>) -> Operand {
-        let ready = |fast: &dyn Fn(&Choice) -> bool| {
-            let times = items.iter().map(|c| match &c.fast {
-                Some(f) if fast(c) => f.ready,
-                _ => c.cheap.ready,
-            });
-            tree_time(times.collect())
-        };
-        let mut cuts: Vec<u32> = items
-            .iter()
-            .filter(|c| c.fast.is_some())
-            .map(|c| c.cheap.ready)
-            .collect();
-        cuts.sort_unstable();
-        cuts.dedup();
-        // Fast from `cut` on (cheap.ready >= cut); u32::MAX: none.
-        let mut best = (ready(&|_| false), u32::MAX);
-        for &cut in cuts.iter().rev() {
-            let t = ready(&|c: &Choice| c.cheap.ready >= cut);
-            if t < best.0 {
-                best = (t, cut);
-            }
-        }
-        let cut = best.1;
-        Operand::sum(
-            items
-                .into_iter()
-                .map(|c| match c.fast {
-                    Some(f) if c.cheap.ready >= cut => (c.negative, f),
-                    _ => (c.negative, c.cheap),
-                })
-                .collect(),
-        )
-    }
-}
-
-/// The time of a sum of operands ready at `times`, combined two earliest first.
-fn tree_time(mut times: Vec<u32>) -> u32 {
-    while times.len() > 1 {
-        times.sort_unstable();
-        let t = times[0].max(times[1]) + ADD;
-        times.splice(0..2, [t]);
-    }
-    times.first().copied().unwrap_or(0)
-}
 
 /// A value of the emitted code: its expression and when it is ready.
 #[derive(Clone, Debug)]
