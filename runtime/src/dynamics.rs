@@ -51,8 +51,8 @@ use crate::linalg::inf_norm;
 use crate::linalg::small::SmallLu;
 use crate::linalg::sparse::SparseKkt;
 use crate::workspace::{
-    all_finite, check_finite, check_len, check_same_model, check_state, scatter_row_major,
-    EvalError, Quantity, Workspace,
+    all_finite, check_finite, check_len, check_same_model, check_state, EvalError, Quantity,
+    Workspace,
 };
 use crate::{AugmentedSolve, Info, Mechanism};
 
@@ -411,7 +411,7 @@ impl Dynamics {
 
         if let Some(split) = self.split.as_mut() {
             right_hand_side(ws, shift, &mut self.b);
-            scatter_jacobian(info, ws);
+            ws.scatter_jacobian();
             let tol = self.params.redundant_tolerance;
             match split.solve(
                 info,
@@ -527,7 +527,7 @@ impl Dynamics {
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
         let (n, m) = (info.nq(), info.nh() + info.nnh());
-        scatter_jacobian(info, ws);
+        ws.scatter_jacobian();
         let mut elim = Elimination::new(m, n);
         elim.load(&ws.jacobian);
         // The constraint block of the augmented matrix has pivots of the order of those
@@ -709,14 +709,6 @@ fn right_hand_side(ws: &Workspace, shift: Option<&[f64]>, b: &mut [f64]) {
 /// $\sum_i a_i b_i$.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// Writes $J = [C_q; G]$ dense, row-major, into `ws.jacobian`.
-fn scatter_jacobian(info: &Info, ws: &mut Workspace) {
-    let (n, mh) = (info.nq(), info.nh());
-    let (h, nh) = ws.jacobian.split_at_mut(mh * n);
-    scatter_row_major(info.holonomic_pattern, &ws.cq_values, n, h);
-    scatter_row_major(info.nonholonomic_pattern, &ws.g_values, n, nh);
 }
 
 /// The coordinates whose accelerations the augmented matrix in `lu` (filled, not yet

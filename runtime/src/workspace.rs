@@ -306,7 +306,9 @@ pub struct Workspace {
     pub(crate) mass_values: Vec<f64>,
     pub(crate) cq_values: Vec<f64>,
     pub(crate) g_values: Vec<f64>,
-    /// Dense row-major `m × n` array of $J = [C_q; G]$.
+    /// Dense row-major `m × n` array of $J = [C_q; G]$. Only
+    /// [`scatter_jacobian`](Self::scatter_jacobian) writes it, at the entries of the
+    /// patterns: the others stay the zeros of the allocation.
     pub(crate) jacobian: Vec<f64>,
     pub(crate) c: Vec<f64>,
     pub(crate) ct: Vec<f64>,
@@ -693,12 +695,20 @@ impl Workspace {
         })
     }
 
-    /// Scatters the pattern values of $C_q$ and $G$ into the dense $J$.
+    /// Scatters the pattern values of $C_q$ and $G$ into the dense $J$: only the
+    /// entries of the patterns are written, the others are zero since the allocation
+    /// and nothing writes them (see [`Workspace::jacobian`]'s field).
     pub(crate) fn scatter_jacobian(&mut self) {
         let n = self.info.nq();
         let (h, nh) = self.jacobian.split_at_mut(self.info.nh() * n);
-        scatter_row_major(self.info.holonomic_pattern, &self.cq_values, n, h);
-        scatter_row_major(self.info.nonholonomic_pattern, &self.g_values, n, nh);
+        for (pattern, values, out) in [
+            (self.info.holonomic_pattern, &self.cq_values, h),
+            (self.info.nonholonomic_pattern, &self.g_values, nh),
+        ] {
+            for (&(r, c), &v) in pattern.iter().zip(values) {
+                out[r as usize * n + c as usize] = v;
+            }
+        }
     }
 
     /// The dense row-major $J = [C_q; G]$ of the last [`Workspace::eval_jacobian`].

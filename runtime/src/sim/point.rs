@@ -36,12 +36,17 @@ pub(crate) const REFIT_RATIO: f64 = 1e-8;
 /// The last full state $(t, q, \dot q)$ a check of the groups saw, with a version of
 /// its position $(t, q)$ and of the whole state: a group of evaluations is stamped
 /// with the version it was made at, so that the stamps are numbers, and the state is
-/// copied once when it changes instead of once per group evaluated at it.
+/// copied once when it changes instead of once per group evaluated at it. A check of a
+/// position group compares $(t, q)$ only; the velocities are compared (or copied, after
+/// a new position) when a group of the whole state is checked.
 #[derive(Debug)]
 struct Versions {
     t: f64,
     q: Vec<f64>,
     qd: Vec<f64>,
+    /// Whether `qd` holds the velocities of the state of version `state` (cleared by a
+    /// new position, whose velocities are copied at the next check of the state).
+    qd_held: bool,
     position: u64,
     state: u64,
 }
@@ -53,27 +58,42 @@ impl Versions {
             t: f64::NAN,
             q: vec![0.0; n],
             qd: vec![0.0; n],
+            qd_held: false,
             position: 1,
             state: 1,
         }
     }
 
-    /// The versions `(position, state)` of `(t, q, qd)`: those of the last state seen
-    /// when it is the same (`t` bitwise, `q` and `qd` by value), new ones otherwise
-    /// (the state then copied).
+    /// The version of the position `(t, q)`: that of the last position seen when it is
+    /// the same (`t` bitwise, `q` by value), a new one otherwise (which also starts a
+    /// new version of the state).
     #[inline]
-    fn sync(&mut self, t: f64, q: &[f64], qd: &[f64]) -> (u64, u64) {
+    fn position(&mut self, t: f64, q: &[f64]) -> u64 {
         if self.t.to_bits() != t.to_bits() || !same(&self.q, q) {
             self.t = t;
             self.q.copy_from_slice(q);
-            self.qd.copy_from_slice(qd);
+            self.qd_held = false;
             self.position += 1;
             self.state += 1;
+        }
+        self.position
+    }
+
+    /// The versions `(position, state)` of `(t, q, qd)` (see
+    /// [`position`](Self::position)); the state's is new when the position is or the
+    /// velocities differ from the last ones seen at it.
+    #[inline]
+    fn sync(&mut self, t: f64, q: &[f64], qd: &[f64]) -> (u64, u64) {
+        let position = self.position(t, q);
+        if !self.qd_held {
+            // A new position has its new state version already.
+            self.qd.copy_from_slice(qd);
+            self.qd_held = true;
         } else if !same(&self.qd, qd) {
             self.qd.copy_from_slice(qd);
             self.state += 1;
         }
-        (self.position, self.state)
+        (position, self.state)
     }
 }
 
@@ -268,7 +288,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// The version of the current $(t, q)$.
     #[inline]
     fn position(&mut self, t: f64) -> u64 {
-        self.versions(t).0
+        self.versions.position(t, &self.q)
     }
 
     /// Keeps only the independent holonomic rows `holonomic` (and every non-holonomic
