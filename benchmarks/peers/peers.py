@@ -495,7 +495,7 @@ def machine(pfaff, load_start):
     return "\n".join([
         f"- date: {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')}",
         f"- CPU: {cpu}, {os.cpu_count()} logical cores; {platform.system()} {platform.release()}; "
-        f"load average (1 min) at the start and at the end {load} (above the number of cores, other work shares the machine)",
+        f"load average (1 min) at the start and at the end {load} (a load above the number of cores means other work shared the machine)",
         f"- pfaff: {tool_version([pfaff, '--version'])}, commit {commit}; {tool_version(['rustc', '--version'])}",
         f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {scipy.__version__}, "
         f"CasADi {casadi.__version__} (SUNDIALS plugins of its wheel); {tool_version(['gcc', '--version'])}, flags {' '.join(CFLAGS)}",
