@@ -23,7 +23,6 @@ use super::error::OdeError;
 use super::integrator::Integrator;
 use super::options::{OdeOptions, OdeStats};
 use super::rk_driver::{embedded_rk_integrator, EmbeddedRk, RkDriver, RkState};
-use super::stages::{combine, row, Stages};
 use super::system::OdeSystem;
 
 /// Index of the FSAL stage $f(t+h, y_{n+1})$ in `k`.
@@ -42,12 +41,52 @@ pub(crate) struct Dp853 {
     /// this time (every step when `None`), see [`Dop853::dense_output_from`].
     dense_from: Option<f64>,
     /// Stage derivatives 1–16 (index = stage − 1).
-    k: Stages,
-    /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f),
-    /// row `r` at `r * n..(r + 1) * n`.
-    cont: Vec<f64>,
-    /// Scratch for the fifth-order error estimate (the third-order one is in `tmp`).
-    err5: Vec<f64>,
+    k: [Vec<f64>; 16],
+    /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f).
+    cont: [Vec<f64>; 8],
+}
+
+/// Components [`combine`] sums together (two SSE2 registers).
+const LANES: usize = 4;
+
+/// `out = y + h * sum_j a_j k_j` over the listed coefficients.
+///
+/// Four components at a time with the sums in registers: each entry sees the
+/// operations of a pass per coefficient ($o \leftarrow y$, then $o \mathrel{+}=
+/// (h a_j) k_j$ in the order of the list), without storing and reloading `out` once
+/// per coefficient (stage 12 has eleven).
+#[inline]
+fn combine(out: &mut [f64], y: &[f64], h: f64, coeffs: &[(usize, f64)], k: &[Vec<f64>]) {
+    let n = out.len();
+    let mut l0 = 0;
+    while l0 + LANES <= n {
+        combine_lanes::<LANES>(out, y, h, coeffs, k, l0);
+        l0 += LANES;
+    }
+    for l0 in l0..n {
+        combine_lanes::<1>(out, y, h, coeffs, k, l0);
+    }
+}
+
+/// [`combine`] for the components `l0..l0 + W`.
+#[inline(always)]
+fn combine_lanes<const W: usize>(
+    out: &mut [f64],
+    y: &[f64],
+    h: f64,
+    coeffs: &[(usize, f64)],
+    k: &[Vec<f64>],
+    l0: usize,
+) {
+    let mut s = <[f64; W]>::try_from(&y[l0..l0 + W]).expect("W entries");
+    for &(j, a) in coeffs {
+        let ha = h * a;
+        let kj = <&[f64; W]>::try_from(&k[j][l0..l0 + W]).expect("W entries");
+        for (s, kj) in s.iter_mut().zip(kj) {
+            *s += ha * kj;
+        }
+    }
+    out[l0..l0 + W].copy_from_slice(&s);
 }
 
 impl Dop853 {
@@ -56,13 +95,13 @@ impl Dop853 {
     /// # Errors
     /// Invalid options, see [`OdeOptions::validate`].
     pub fn new(dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
+        let v = || vec![0.0; dim];
         let ctrl = PiController::new(1.0 / 8.0, 0.0, 0.9, 0.333, 6.0);
         let m = Dp853 {
             dense_ready: false,
             dense_from: None,
-            k: Stages::new(dim, 16),
-            cont: vec![0.0; 8 * dim],
-            err5: vec![0.0; dim],
+            k: std::array::from_fn(|_| v()),
+            cont: std::array::from_fn(|_| v()),
         };
         RkDriver::new(dim, opts, ctrl, m).map(Self)
     }
@@ -83,23 +122,6 @@ impl Dop853 {
 }
 
 impl Dp853 {
-    /// The argument $y + h\sum_j a_{sj} k_j$ of stage `s` (0-based, 1–15) into
-    /// `st.tmp`, each row of `A` as an array of its length (checked at compile time).
-    #[inline]
-    fn argument(&mut self, st: &mut RkState, s: usize, h: f64) {
-        let (out, y, done) = (&mut st.tmp, Some(&st.y[..]), self.k.all());
-        macro_rules! rows {
-            ($($s:literal: $c:literal),* $(,)?) => {
-                match s {
-                    $( $s => combine(out, y, h, &const { row::<$c>(A[$s]) }, done), )*
-                    _ => unreachable!("stage {s} has no argument"),
-                }
-            };
-        }
-        rows!(1: 1, 2: 2, 3: 2, 4: 3, 5: 3, 6: 4, 7: 5, 8: 6, 9: 7, 10: 8, 11: 9,
-            13: 8, 14: 8, 15: 8);
-    }
-
     /// Evaluates stage `s` (0-based) of a step of size `h` from the current state.
     fn stage<S: OdeSystem + ?Sized>(
         &mut self,
@@ -108,14 +130,9 @@ impl Dp853 {
         s: usize,
         h: f64,
     ) -> Result<(), OdeError> {
-        self.argument(st, s, h);
-        eval(
-            sys,
-            &mut st.stats,
-            st.t + C[s] * h,
-            &st.tmp,
-            self.k.get_mut(s),
-        )
+        let (done, rest) = self.k.split_at_mut(s);
+        combine(&mut st.tmp, &st.y, h, A[s], done);
+        eval(sys, &mut st.stats, st.t + C[s] * h, &st.tmp, &mut rest[0])
     }
 
     /// Evaluates the three extra stages and stores the interpolant of the accepted step
@@ -129,65 +146,66 @@ impl Dp853 {
         for s in 13..16 {
             self.stage(st, sys, s, h)?;
         }
-        let n = st.y.len();
-        let (y, y_new) = (&st.y[..n], &st.y_new[..n]);
-        let (k1, kf) = (self.k.get(0), self.k.get(FSAL));
-        let (c, rest) = self.cont.split_at_mut(4 * n);
-        let (c12, c34) = c.split_at_mut(2 * n);
-        let (c1, c2) = c12.split_at_mut(n);
-        let (c3, c4) = c34.split_at_mut(n);
-        for i in 0..n {
-            let ydiff = y_new[i] - y[i];
-            let bspl = h * k1[i] - ydiff;
-            c1[i] = y[i];
+        let [c1, c2, c3, c4, rest @ ..] = &mut self.cont;
+        for i in 0..st.y.len() {
+            let ydiff = st.y_new[i] - st.y[i];
+            let bspl = h * self.k[0][i] - ydiff;
+            c1[i] = st.y[i];
             c2[i] = ydiff;
             c3[i] = bspl;
-            c4[i] = ydiff - h * kf[i] - bspl;
+            c4[i] = ydiff - h * self.k[FSAL][i] - bspl;
         }
-        let k = self.k.all();
-        for (r, d) in [
-            const { row::<12>(D[0]) },
-            const { row::<12>(D[1]) },
-            const { row::<12>(D[2]) },
-            const { row::<12>(D[3]) },
-        ]
-        .iter()
-        .enumerate()
-        {
-            combine(&mut rest[r * n..][..n], None, h, d, k);
+        for (c, d) in rest.iter_mut().zip(D) {
+            c.fill(0.0);
+            for &(j, dj) in d {
+                for (ci, kj) in c.iter_mut().zip(&self.k[j]) {
+                    *ci += h * dj * kj;
+                }
+            }
         }
         Ok(())
     }
 }
 
-/// The weights $b_j$ of the eighth-order solution (row 12 of `A`).
-const B: [(usize, f64); 8] = row::<8>(A[FSAL]);
-
-/// The third-order error estimate's coefficients as one row: $\sum_j b_j k_j - \sum_j
-/// \hat b_j k_j$ with $\hat b$ = `BHH` (negated: $e + (-\hat b)k = e - \hat b k$
-/// exactly).
-const ERR3: [(usize, f64); 11] = {
-    let mut out = [(0, 0.0); 11];
-    let mut i = 0;
-    while i < 8 {
-        out[i] = B[i];
-        i += 1;
+impl Dp853 {
+    /// The error sums of [`attempt`](EmbeddedRk::attempt) for the components
+    /// `l0..l0 + W`: the two error estimates summed in registers coefficient by
+    /// coefficient (each entry sees the operations of `dop853.f` in their order), then
+    /// added to `e3` and `e5` component by component, in order.
+    #[inline(always)]
+    fn error_lanes<const W: usize>(&self, st: &RkState, l0: usize, e3: &mut f64, e5: &mut f64) {
+        let (mut err3, mut err5) = ([0.0; W], [0.0; W]);
+        let lanes = |j: usize| <&[f64; W]>::try_from(&self.k[j][l0..l0 + W]).expect("W entries");
+        for &(j, b) in A[FSAL] {
+            for (e, k) in err3.iter_mut().zip(lanes(j)) {
+                *e += b * k;
+            }
+        }
+        for &(j, b) in BHH {
+            for (e, k) in err3.iter_mut().zip(lanes(j)) {
+                *e -= b * k;
+            }
+        }
+        for &(j, c) in ER {
+            for (e, k) in err5.iter_mut().zip(lanes(j)) {
+                *e += c * k;
+            }
+        }
+        let tol = &st.opts.tol;
+        for (w, (err3, err5)) in err3.iter().zip(&err5).enumerate() {
+            let i = l0 + w;
+            let sk = tol.atol(i) + tol.rtol * st.y[i].abs().max(st.y_new[i].abs());
+            *e3 += (err3 / sk) * (err3 / sk);
+            *e5 += (err5 / sk) * (err5 / sk);
+        }
     }
-    while i < 11 {
-        out[i] = (BHH[i - 8].0, -BHH[i - 8].1);
-        i += 1;
-    }
-    out
-};
-
-/// The fifth-order error estimate's coefficients `ER`.
-const ERR5: [(usize, f64); 8] = row::<8>(ER);
+}
 
 impl EmbeddedRk for Dp853 {
     const ORDER: i32 = 8;
     const FSAL: usize = FSAL;
 
-    fn stages(&mut self) -> &mut Stages {
+    fn k(&mut self) -> &mut [Vec<f64>] {
         &mut self.k
     }
 
@@ -201,32 +219,26 @@ impl EmbeddedRk for Dp853 {
         for s in 1..12 {
             self.stage(st, sys, s, h)?;
         }
-        let k = self.k.all();
-        combine(&mut st.y_new, Some(&st.y), h, &B, k);
+        combine(&mut st.y_new, &st.y, h, A[FSAL], &self.k);
         if check_state(st.t + h, &st.y_new).is_err() {
             return Ok(f64::INFINITY);
         }
-        // The two estimates with the kernel of the stages (each entry sees the
-        // operations of dop853.f in their order: `h = 1` scales nothing), then their
-        // sums component by component, in order.
-        combine(&mut st.tmp, None, 1.0, &ERR3, k);
-        combine(&mut self.err5, None, 1.0, &ERR5, k);
-        let n = st.y.len();
-        let (err3, err5) = (&st.tmp[..n], &self.err5[..n]);
-        let (y, y_new) = (&st.y[..n], &st.y_new[..n]);
-        let tol = &st.opts.tol;
         let (mut e5, mut e3) = (0.0, 0.0);
-        for i in 0..n {
-            let sk = tol.atol(i) + tol.rtol * y[i].abs().max(y_new[i].abs());
-            e3 += (err3[i] / sk) * (err3[i] / sk);
-            e5 += (err5[i] / sk) * (err5[i] / sk);
+        let n = st.y.len();
+        let mut l0 = 0;
+        while l0 + LANES <= n {
+            self.error_lanes::<LANES>(st, l0, &mut e3, &mut e5);
+            l0 += LANES;
+        }
+        for l0 in l0..n {
+            self.error_lanes::<1>(st, l0, &mut e3, &mut e5);
         }
         let deno = if e5 + 0.01 * e3 > 0.0 {
             e5 + 0.01 * e3
         } else {
             1.0
         };
-        Ok(h.abs() * e5 * (1.0 / (n as f64 * deno)).sqrt())
+        Ok(h.abs() * e5 * (1.0 / (st.y.len() as f64 * deno)).sqrt())
     }
 
     /// The FSAL stage $f(t_{\text{new}}, y_{n+1})$ and, with `dense_output` (on a step
@@ -239,7 +251,7 @@ impl EmbeddedRk for Dp853 {
         h: f64,
         t_new: f64,
     ) -> Result<(), OdeError> {
-        let mut fsal = eval(sys, &mut st.stats, t_new, &st.y_new, self.k.get_mut(FSAL));
+        let mut fsal = eval(sys, &mut st.stats, t_new, &st.y_new, &mut self.k[FSAL]);
         self.dense_ready = false;
         let wanted = self.dense_from.is_none_or(|td| (t_new - td) * h >= 0.0);
         if fsal.is_ok() && st.opts.dense_output && wanted {
@@ -258,9 +270,8 @@ impl EmbeddedRk for Dp853 {
             return Err(OdeError::DenseOutputUnavailable);
         }
         let s1 = 1.0 - s;
-        let n = out.len();
-        let [r1, r2, r3, r4, r5, r6, r7, r8] = std::array::from_fn(|r| &self.cont[r * n..][..n]);
-        for i in 0..n {
+        let [r1, r2, r3, r4, r5, r6, r7, r8] = &self.cont;
+        for i in 0..out.len() {
             let p = r5[i] + s * (r6[i] + s1 * (r7[i] + s * r8[i]));
             out[i] = r1[i] + s * (r2[i] + s1 * (r3[i] + s * (r4[i] + s1 * p)));
         }

@@ -22,7 +22,6 @@ use super::error::OdeError;
 use super::integrator::Integrator;
 use super::options::{OdeOptions, OdeStats};
 use super::rk_driver::{embedded_rk_integrator, EmbeddedRk, RkDriver, RkState};
-use super::stages::Stages;
 use super::system::OdeSystem;
 
 const C2: f64 = 0.2;
@@ -75,7 +74,7 @@ pub(crate) struct Dp5 {
     /// this time (every step when `None`), see [`Dopri5::dense_output_from`].
     dense_from: Option<f64>,
     /// Stage derivatives 1–7 (index = stage − 1).
-    k: Stages,
+    k: [Vec<f64>; 7],
     /// Coefficients of the interpolant on the last step (`rcont1..5` of dopri5.f),
     /// row `r` at `r * n..(r + 1) * n`.
     cont: Vec<f64>,
@@ -91,7 +90,7 @@ impl Dopri5 {
         let m = Dp5 {
             dense_ready: false,
             dense_from: None,
-            k: Stages::new(dim, 7),
+            k: std::array::from_fn(|_| vec![0.0; dim]),
             cont: vec![0.0; 5 * dim],
         };
         RkDriver::new(dim, opts, ctrl, m).map(Self)
@@ -111,23 +110,18 @@ impl Dopri5 {
     }
 }
 
-/// The seven stages of `k` (each of length `n`).
+/// The stages of `k`, each cut to length `n` (so that the loops over `0..n`
+/// index them without bounds checks).
 #[inline]
-fn split7(k: &mut [f64], n: usize) -> [&mut [f64]; 7] {
-    let (k1, k) = k.split_at_mut(n);
-    let (k2, k) = k.split_at_mut(n);
-    let (k3, k) = k.split_at_mut(n);
-    let (k4, k) = k.split_at_mut(n);
-    let (k5, k) = k.split_at_mut(n);
-    let (k6, k7) = k.split_at_mut(n);
-    [k1, k2, k3, k4, k5, k6, &mut k7[..n]]
+fn cut<const S: usize>(k: &mut [Vec<f64>; S], n: usize) -> [&mut [f64]; S] {
+    k.each_mut().map(|k| &mut k[..n])
 }
 
 impl EmbeddedRk for Dp5 {
     const ORDER: i32 = 5;
     const FSAL: usize = 6;
 
-    fn stages(&mut self) -> &mut Stages {
+    fn k(&mut self) -> &mut [Vec<f64>] {
         &mut self.k
     }
 
@@ -140,7 +134,7 @@ impl EmbeddedRk for Dp5 {
     ) -> Result<f64, OdeError> {
         let n = st.y.len();
         let (t, y, tmp) = (st.t, &st.y[..n], &mut st.tmp[..n]);
-        let [k1, k2, k3, k4, k5, k6, k7] = split7(self.k.all_mut(), n);
+        let [k1, k2, k3, k4, k5, k6, k7] = cut(&mut self.k, n);
         let stats = &mut st.stats;
         for i in 0..n {
             tmp[i] = y[i] + h * A21 * k1[i];
@@ -195,7 +189,7 @@ impl EmbeddedRk for Dp5 {
             return Ok(());
         }
         let n = st.y.len();
-        let [k1, _, k3, k4, k5, k6, k7] = split7(self.k.all_mut(), n);
+        let [k1, _, k3, k4, k5, k6, k7] = cut(&mut self.k, n);
         let (c1, c) = self.cont.split_at_mut(n);
         let (c2, c) = c.split_at_mut(n);
         let (c3, c) = c.split_at_mut(n);

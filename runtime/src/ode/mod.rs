@@ -35,7 +35,6 @@ mod radau;
 mod rk4;
 mod rk_driver;
 pub mod samples;
-mod stages;
 mod system;
 
 pub use adams::Adams;

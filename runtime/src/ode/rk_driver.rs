@@ -5,7 +5,7 @@
 //! the common state [`RkState`]. Output: [`Integrator`] behaviour — reset with Hairer's
 //! `HINIT`, one accepted step per call (stop times, `max_steps`, underflow, retry after
 //! a recoverable failure, PI control with `h_max`, FSAL), dense output and `set_state`.
-//! Invariants: the first stage holds $f(t, y)$ whenever `fsal` is set; stepping does
+//! Invariants: the stage `k[0]` holds $f(t, y)$ whenever `fsal` is set; stepping does
 //! not allocate.
 //!
 //! [`Dopri5`]: super::Dopri5
@@ -18,7 +18,6 @@ use super::common::{
 };
 use super::error::OdeError;
 use super::options::{check_h0, OdeOptions, OdeStats};
-use super::stages::Stages;
 use super::system::OdeSystem;
 
 /// What every embedded pair keeps: options, controller, the accepted state, the
@@ -28,7 +27,7 @@ pub(crate) struct RkState {
     pub(crate) opts: OdeOptions,
     ctrl: PiController,
     started: bool,
-    /// Whether the first stage holds $f(t, y)$ for the current state.
+    /// Whether `k[0]` holds $f(t, y)$ for the current state.
     fsal: bool,
     dir: f64,
     pub(crate) t: f64,
@@ -64,12 +63,12 @@ impl RkState {
 pub(crate) trait EmbeddedRk {
     /// The order $p$ given to `HINIT`.
     const ORDER: i32;
-    /// Index in [`stages`](Self::stages) of the stage $f(t+h, y_{n+1})$, the first
-    /// stage of the next step.
+    /// Index in [`k`](Self::k) of the stage $f(t+h, y_{n+1})$, the first stage of the
+    /// next step.
     const FSAL: usize;
 
-    /// The stage derivatives (at least 3; the first is $f(t, y)$).
-    fn stages(&mut self) -> &mut Stages;
+    /// The stage derivatives (at least 3; `k[0]` is $f(t, y)$).
+    fn k(&mut self) -> &mut [Vec<f64>];
 
     /// One attempt of size `h` from `(st.t, st.y)`: the stages, $y_{n+1}$ into
     /// `st.y_new`; returns the error norm (infinite for a non-finite $y_{n+1}$).
@@ -190,15 +189,14 @@ impl<M: EmbeddedRk> RkDriver<M> {
         st.attempts = 0;
         st.ctrl.reset();
         st.dir = h0.map_or(1.0, f64::signum);
-        let k = self.m.stages();
-        eval(sys, &mut st.stats, t0, &st.y, k.get_mut(0))?;
+        let k = self.m.k();
+        eval(sys, &mut st.stats, t0, &st.y, &mut k[0])?;
         st.fsal = true;
         st.h = match h0 {
             Some(h) => h,
             None => {
-                let n = st.y.len();
-                let (k1, rest) = k.all_mut().split_at_mut(n);
-                let (k2, k3) = rest.split_at_mut(n);
+                let (k1, rest) = k.split_at_mut(1);
+                let (k2, k3) = rest.split_at_mut(1);
                 let (tol, h_max, dir) = (&st.opts.tol, st.opts.h_max, st.dir);
                 hinit(
                     sys,
@@ -207,9 +205,9 @@ impl<M: EmbeddedRk> RkDriver<M> {
                     M::ORDER,
                     h_max,
                     dir,
-                    (t0, &st.y, k1),
-                    k2,
-                    &mut k3[..n],
+                    (t0, &st.y, &k1[0]),
+                    &mut k2[0],
+                    &mut k3[0],
                 )?
             }
         };
@@ -230,7 +228,7 @@ impl<M: EmbeddedRk> RkDriver<M> {
             return Ok(st.t);
         }
         if !st.fsal {
-            eval(sys, &mut st.stats, st.t, &st.y, m.stages().get_mut(0))?;
+            eval(sys, &mut st.stats, st.t, &st.y, &mut m.k()[0])?;
             st.fsal = true;
         }
         let mut rejected = false;
@@ -280,7 +278,7 @@ impl<M: EmbeddedRk> RkDriver<M> {
                 continue;
             }
             std::mem::swap(&mut st.y, &mut st.y_new);
-            m.stages().copy(M::FSAL, 0);
+            m.k().swap(0, M::FSAL);
             st.t_prev = st.t;
             st.t = t_new;
             st.h_last = h;
