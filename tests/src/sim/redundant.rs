@@ -115,7 +115,10 @@ fn parallelogram_runs_through_its_flat_configurations() {
         // rank drop itself: there C_q fixes φ only to the square root of the Newton
         // tolerance (ARCHITECTURE.md).
         let bound = 1e3 * rtol + 5e-8;
-        assert!(e_theta < bound && e_omega < 3.0 * bound, "{e_theta:e} {e_omega:e}");
+        assert!(
+            e_theta < bound && e_omega < 3.0 * bound,
+            "{e_theta:e} {e_omega:e}"
+        );
         assert!(drift < bound * 15.0, "{drift:e}");
         assert!(q[5].abs() < 1e-9, "φ = {:e}", q[5]);
     }
