@@ -163,8 +163,20 @@ impl Printer<'_> {
                 Node::Call(Func::Cos, u) => (j, k, *u),
                 _ => unreachable!("pairs are a sine and a cosine"),
             };
-            let (u, _) = self.expr(u, false);
             let (sin, cos) = (place(sin), place(cos));
+            if let Some(sum) = self.prog.angle_sums.get(&id) {
+                let [sa, ca, sb, cb] = sum.pairs.map(|p| {
+                    let (ts, p) = self.expr(p, false);
+                    wrap(ts, p, Prec::Atom)
+                });
+                // sin(a ± b) = sin a cos b ± cos a sin b, cos(a ± b) = cos a cos b ∓ sin a sin b.
+                return if sum.minus {
+                    quote!(#let_ #sin = #sa * #cb - #ca * #sb; #let_ #cos = #ca * #cb + #sa * #sb;)
+                } else {
+                    quote!(#let_ #sin = #sa * #cb + #ca * #sb; #let_ #cos = #ca * #cb - #sa * #sb;)
+                };
+            }
+            let (u, _) = self.expr(u, false);
             return quote!(#let_ (#sin, #cos) = ::pfaff::math::sin_cos(#u););
         }
         let (ts, _) = self.expr(id, true);

@@ -46,6 +46,8 @@ pub struct Program {
     pub run_vars: BTreeSet<Var>,
     /// For `sin u` its live `cos u` and the other way round: both are temporaries.
     pub partner: HashMap<ExprId, ExprId>,
+    /// The pairs defined from the pairs of two angles they sum, by sine and by cosine.
+    pub angle_sums: HashMap<ExprId, AngleSum>,
 }
 
 impl Program {
@@ -76,6 +78,10 @@ impl Program {
             if let Some(&other) = self.partner.get(&id) {
                 stack.push(other);
             }
+            if let Some(sum) = self.angle_sums.get(&id) {
+                stack.extend(sum.operands());
+                continue;
+            }
             match g.node(id) {
                 Node::Var(v) => {
                     vars.insert(*v);
@@ -99,38 +105,20 @@ pub fn schedule(g: &Graph, roots: &[ExprId]) -> Program {
 /// `Var::Data` indices, one per slot) as runs.
 pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Program {
     let mut runs = HashMap::new();
-    // Post-order of the live nodes; a sum with runs has only its remaining terms as
-    // operands.
-    let mut seen = vec![false; g.len()];
-    let mut order = Vec::new();
-    let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
-    while let Some((id, expanded)) = stack.pop() {
-        if expanded {
-            order.push(id);
-            continue;
-        }
-        if seen[id.index()] {
-            continue;
-        }
-        seen[id.index()] = true;
-        stack.push((id, true));
-        let kids = match g.node(id) {
-            Node::Add(terms) if !slots.is_empty() => match runs::find(g, terms, slots) {
-                Some((r, rest)) => {
-                    let kids = rest.clone();
-                    runs.insert(id, (r, rest));
-                    kids
-                }
-                None => terms.to_vec(),
-            },
-            node => node.args(),
-        };
-        for a in kids.into_iter().rev() {
-            if !seen[a.index()] {
-                stack.push((a, false));
-            }
-        }
-    }
+    let order = live_order(g, roots, slots, &mut runs, &HashMap::new());
+    let mut partner = sin_cos_pairs(g, &order);
+    let mut angle_sums = angle_sums(g, &partner);
+    // The pairs of a sum of angles read the pairs of its terms, not the sum: schedule
+    // again with those operands. A pair live only through a sum no longer read is
+    // then dead, so the pairs are taken again from the live nodes.
+    let order = if angle_sums.is_empty() {
+        order
+    } else {
+        let order = live_order(g, roots, slots, &mut runs, &angle_sums);
+        partner = sin_cos_pairs(g, &order);
+        angle_sums.retain(|id, _| partner.contains_key(id));
+        order
+    };
     let mut uses = vec![0u32; g.len()];
     let mut vars = BTreeSet::new();
     for &id in &order {
@@ -139,9 +127,10 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
                 vars.insert(*v);
             }
             node => {
-                let kids = match runs.get(&id) {
-                    Some((_, rest)) => rest.clone(),
-                    None => node.args(),
+                let kids = match (runs.get(&id), angle_sums.get(&id)) {
+                    (_, Some(sum)) => sum.operands().to_vec(),
+                    (Some((_, rest)), None) => rest.clone(),
+                    (None, None) => node.args(),
                 };
                 for a in kids {
                     uses[a.index()] += 1;
@@ -152,7 +141,6 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
     for r in roots {
         uses[r.index()] += 1;
     }
-    let partner = sin_cos_pairs(g, &order);
     let mut temp_of = vec![None; g.len()];
     let mut lets = Vec::new();
     for &id in &order {
@@ -174,7 +162,118 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
         runs,
         run_vars,
         partner,
+        angle_sums,
     }
+}
+
+/// The post-order of the live nodes of `roots`. A sum with runs (found over `slots`
+/// and recorded in `runs`) has only its remaining terms as operands, and the sine and
+/// cosine of a sum of angles in `sums` the pairs of its terms instead of the sum.
+fn live_order(
+    g: &Graph,
+    roots: &[ExprId],
+    slots: &[Range<u32>],
+    runs: &mut HashMap<ExprId, (Vec<Run>, Vec<ExprId>)>,
+    sums: &HashMap<ExprId, AngleSum>,
+) -> Vec<ExprId> {
+    let mut seen = vec![false; g.len()];
+    let mut order = Vec::new();
+    let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
+    while let Some((id, expanded)) = stack.pop() {
+        if expanded {
+            order.push(id);
+            continue;
+        }
+        if seen[id.index()] {
+            continue;
+        }
+        seen[id.index()] = true;
+        stack.push((id, true));
+        let kids = match g.node(id) {
+            _ if sums.contains_key(&id) => sums[&id].operands().to_vec(),
+            Node::Add(terms) if !slots.is_empty() => match runs.get(&id) {
+                Some((_, rest)) => rest.clone(),
+                None => match runs::find(g, terms, slots) {
+                    Some((r, rest)) => {
+                        let kids = rest.clone();
+                        runs.insert(id, (r, rest));
+                        kids
+                    }
+                    None => terms.to_vec(),
+                },
+            },
+            node => node.args(),
+        };
+        for a in kids.into_iter().rev() {
+            if !seen[a.index()] {
+                stack.push((a, false));
+            }
+        }
+    }
+    order
+}
+
+/// `sin(a ± b)` and `cos(a ± b)` from the pairs of `a` and `b`:
+/// $\sin(a \pm b) = \sin a \cos b \pm \cos a \sin b$,
+/// $\cos(a \pm b) = \cos a \cos b \mp \sin a \sin b$.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AngleSum {
+    /// `[sin a, cos a, sin b, cos b]`.
+    pub pairs: [ExprId; 4],
+    /// Whether the sum is `a − b`.
+    pub minus: bool,
+}
+
+impl AngleSum {
+    /// The temporaries it reads.
+    pub fn operands(&self) -> &[ExprId; 4] {
+        &self.pairs
+    }
+}
+
+/// The live sine–cosine pairs whose argument is a sum `a + b` or `a − b` of two terms
+/// whose own pairs are live: each maps (sine and cosine alike) to the [`AngleSum`]
+/// that defines it with four products instead of a call of `sin_cos`. A linkage's
+/// absolute angles are sums of its joint angles, whose sines and cosines the same
+/// function evaluates anyway.
+fn angle_sums(g: &Graph, partner: &HashMap<ExprId, ExprId>) -> HashMap<ExprId, AngleSum> {
+    let mut pair_of = HashMap::new();
+    for (&s, &c) in partner {
+        if let (Node::Call(Func::Sin, u), Node::Call(Func::Cos, _)) = (g.node(s), g.node(c)) {
+            pair_of.insert(*u, (s, c));
+        }
+    }
+    let negated = |t: ExprId| match g.node(t) {
+        Node::Mul(f) if f.len() == 2 => match g.node(f[0]) {
+            Node::Const(b) if f64::from_bits(*b) == -1.0 => Some(f[1]),
+            _ => None,
+        },
+        _ => None,
+    };
+    let mut sums = HashMap::new();
+    for (&u, &(s, c)) in &pair_of {
+        let Node::Add(terms) = g.node(u) else {
+            continue;
+        };
+        let [x, y] = terms[..] else {
+            continue;
+        };
+        // `a − b` with `b` the negated term; `x + y` otherwise.
+        let (a, b, minus) = match (negated(x), negated(y)) {
+            (None, Some(b)) => (x, b, true),
+            (Some(a), None) => (y, a, true),
+            _ => (x, y, false),
+        };
+        if let (Some(&(sa, ca)), Some(&(sb, cb))) = (pair_of.get(&a), pair_of.get(&b)) {
+            let sum = AngleSum {
+                pairs: [sa, ca, sb, cb],
+                minus,
+            };
+            sums.insert(s, sum);
+            sums.insert(c, sum);
+        }
+    }
+    sums
 }
 
 /// The live `sin u` and `cos u` of a common argument `u`, each mapped to the other.
@@ -195,4 +294,40 @@ fn sin_cos_pairs(g: &Graph, order: &[ExprId]) -> HashMap<ExprId, ExprId> {
         }
     }
     partner
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `sin(a + b)`, `cos(a + b)`, `sin(a − b)` and `cos(a − b)` beside the pairs of
+    /// `a` and `b` are defined from those pairs, after them, and the sums themselves
+    /// are not computed; without `cos b` the sum's pair is one call of `sin_cos` again.
+    #[test]
+    fn sums_of_angles_read_the_pairs_of_their_terms() {
+        let mut g = Graph::new();
+        let (a, b) = (g.var(Var::Q(0)), g.var(Var::Q(1)));
+        let (sa, ca) = (g.call(Func::Sin, a), g.call(Func::Cos, a));
+        let (sb, cb) = (g.call(Func::Sin, b), g.call(Func::Cos, b));
+        let (sum, diff) = (g.add(vec![a, b]), g.sub(a, b));
+        let (ss, cs) = (g.call(Func::Sin, sum), g.call(Func::Cos, sum));
+        let (sd, cd) = (g.call(Func::Sin, diff), g.call(Func::Cos, diff));
+        let p = schedule(&g, &[sa, ca, sb, cb, ss, cs, sd, cd]);
+        let pairs = [sa, ca, sb, cb];
+        for (id, minus) in [(ss, false), (cs, false), (sd, true), (cd, true)] {
+            assert_eq!(p.angle_sums.get(&id), Some(&AngleSum { pairs, minus }));
+            let k = p.temp(id).expect("a pair is a temporary");
+            for o in pairs {
+                assert!(p.temp(o).expect("an operand is a temporary") < k);
+            }
+        }
+        assert!(!p.lets.contains(&sum) && !p.lets.contains(&diff));
+        let (needed, vars) = p.needed(&g, &[ss]);
+        assert!(pairs.iter().all(|o| needed[o.index()]) && !needed[sum.index()]);
+        assert_eq!(vars, BTreeSet::from([Var::Q(0), Var::Q(1)]));
+
+        let p = schedule(&g, &[sa, ca, sb, ss, cs]);
+        assert!(p.angle_sums.is_empty());
+        assert_eq!(p.partner.get(&ss), Some(&cs));
+    }
 }
