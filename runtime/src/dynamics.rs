@@ -222,6 +222,8 @@ struct Split {
     xt: Vec<f64>,
     /// $\lambda_R$ mapped to the least-norm multipliers, length $r$.
     y: Vec<f64>,
+    /// $w_d = J_d - T_d J_R$ of one row of $D$, length $n$.
+    w: Vec<f64>,
 }
 
 /// A dense factorization sized for its use: partial pivoting below the crossover,
@@ -281,7 +283,41 @@ enum SplitFailure {
     Singular(f64),
     /// The rows $D$ disagree with $\ddot q$ (residual).
     Inconsistent(f64),
+    /// A row of $D$ is no longer dependent on $R$ by the rank rule (the motion left
+    /// the rank drop the split was made at); the rows' residual.
+    Independent(f64),
 }
+
+/// The velocities of the state a solve is made at, for the check of the redundant
+/// rows near a rank drop of $J$ (see [`Split::solve`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Velocities<'a> {
+    /// $v = J\dot q + [C_t; g]$, every row.
+    pub residuals: &'a [f64],
+    /// $\lVert\dot q\rVert_\infty$.
+    pub speed: f64,
+}
+
+/// What [`Split::solve`] checks.
+#[derive(Clone, Copy, Debug)]
+struct Check<'a> {
+    redundant_tolerance: f64,
+    rank_tolerance: f64,
+    velocities: Option<Velocities<'a>>,
+    /// A split kept from an earlier solve, whose rows $D$ must still be dependent on
+    /// $R$ by the rank rule ([`crate::RANK_PIVOT`]).
+    kept: bool,
+}
+
+/// Multiple of [`crate::RANK_PIVOT`] by which a row of a kept split must exceed the
+/// rank rule's distance to count as independent again: the split found by complete
+/// pivoting measures pivots, the check distances, which agree within a small factor.
+const INDEPENDENT: f64 = 10.0;
+
+/// Safety factor on the first-order bound of the acceleration residual of a row that
+/// is dependent only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): the
+/// bound's rate of the rows is estimated from $\gamma$.
+const RANK_DROP_SAFETY: f64 = 4.0;
 
 impl Dynamics {
     /// Scratch for the model described by `info`; the sparse symbolic factorization is
@@ -383,7 +419,7 @@ impl Dynamics {
         // The solution buffer leaves `self` for the call (a move of the vector, no
         // allocation) and comes back whatever the outcome.
         let mut out = std::mem::take(&mut self.out);
-        let stats = self.solve_evaluated(mech, ws, t, shift, &mut out);
+        let stats = self.solve_evaluated(mech, ws, t, shift, None, &mut out);
         if stats.is_ok() {
             qdd.copy_from_slice(&out[..n]);
             lambda.copy_from_slice(&out[n..]);
@@ -397,12 +433,16 @@ impl Dynamics {
     /// `out` $= [\ddot q; \lambda]$ (length $n + m$; its contents are unspecified
     /// after an error). The model's generated solve works in `out` itself: the
     /// right-hand side is written there and solved in place, with no copy in between.
+    /// `velocities`, when given, are those of the state (see [`Velocities`]): the
+    /// redundant rows' check then allows for the rows that are dependent only near a
+    /// rank drop of $J$.
     pub(crate) fn solve_evaluated<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
         ws: &mut Workspace,
         t: f64,
         shift: Option<&[f64]>,
+        velocities: Option<Velocities<'_>>,
         out: &mut [f64],
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
@@ -413,14 +453,13 @@ impl Dynamics {
             right_hand_side(ws, shift, &mut self.b);
             ws.scatter_jacobian();
             let tol = self.params.redundant_tolerance;
-            match split.solve(
-                info,
-                ws,
-                &self.b,
-                tol,
-                self.params.rank_tolerance,
-                &mut self.x,
-            ) {
+            let check = Check {
+                redundant_tolerance: tol,
+                rank_tolerance: self.params.rank_tolerance,
+                velocities,
+                kept: true,
+            };
+            match split.solve(info, ws, &self.b, check, &mut self.x) {
                 Ok(ratio) => {
                     self.redundant.extend_from_slice(&split.rows_d);
                     let stats = AccelerationStats {
@@ -499,7 +538,7 @@ impl Dynamics {
         };
         let stats = match stats {
             Some(s) => s,
-            None => self.solve_redundant(ws, t)?,
+            None => self.solve_redundant(ws, t, velocities)?,
         };
         self.finish(t, out, stats)
     }
@@ -524,6 +563,7 @@ impl Dynamics {
         &mut self,
         ws: &mut Workspace,
         t: f64,
+        velocities: Option<Velocities<'_>>,
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
         let (n, m) = (info.nq(), info.nh() + info.nnh());
@@ -554,8 +594,14 @@ impl Dynamics {
             self.params.crossover,
         );
         self.redundant.extend_from_slice(&split.rows_d);
-        let (tol, rank_tol) = (self.params.redundant_tolerance, self.params.rank_tolerance);
-        match split.solve(info, ws, &self.b, tol, rank_tol, &mut self.x) {
+        let rank_tol = self.params.rank_tolerance;
+        let check = Check {
+            redundant_tolerance: self.params.redundant_tolerance,
+            rank_tolerance: rank_tol,
+            velocities,
+            kept: false,
+        };
+        match split.solve(info, ws, &self.b, check, &mut self.x) {
             Ok(ratio) => {
                 self.split = Some(split);
                 Ok(AccelerationStats {
@@ -574,7 +620,8 @@ impl Dynamics {
                     coordinates: free_coordinates(&mut lu, info, rank_tol),
                 })
             }
-            Err(SplitFailure::Inconsistent(residual)) => {
+            // (A fresh split is not checked for independent rows.)
+            Err(SplitFailure::Inconsistent(residual) | SplitFailure::Independent(residual)) => {
                 Err(DynamicsError::InconsistentRedundant {
                     t,
                     constraints: self.redundant_constraints().collect(),
@@ -599,6 +646,7 @@ impl Split {
             gram: Lu::new(r, crossover),
             xt: vec![0.0; r * rows_d.len()],
             y: vec![0.0; r],
+            w: vec![0.0; n],
             rows_r,
             rows_d,
             slot,
@@ -609,14 +657,22 @@ impl Split {
     /// $[\ddot q; \lambda]$ (least-norm multipliers, module docs) into `out`; `b` is
     /// the full right-hand side $[Q; \gamma]$, $J$ is in `ws.jacobian` (dense). Returns
     /// the pivot ratio of the reduced matrix.
+    ///
+    /// The rows $D$ must meet $\ddot q$ to the relative `redundant_tolerance`, or, with
+    /// the state's velocities, within the first-order bound of a row that is dependent
+    /// only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): with
+    /// $T_d = X_d^\mathsf{T}$ the least-squares combination of the rows $R$ and
+    /// $w_d = J_d - T_d J_R$ what the row adds to them,
+    /// $|J_d\ddot q - \gamma_d| \le 2\lVert\dot w_d\rVert\,|v_d - T_d v_R| / \lVert w_d\rVert$,
+    /// with $\lVert\dot w_d\rVert$ estimated by
+    /// $(1 + \lVert T_d\rVert_1)\max_i|\gamma_i| / \lVert\dot q\rVert_\infty$.
     #[allow(non_snake_case)]
     fn solve(
         &mut self,
         info: &Info,
         ws: &Workspace,
         b: &[f64],
-        redundant_tolerance: f64,
-        rank_tolerance: f64,
+        check: Check<'_>,
         out: &mut [f64],
     ) -> Result<f64, SplitFailure> {
         let n = info.nq();
@@ -625,7 +681,7 @@ impl Split {
         let reduced = &mut self.reduced;
         augmented_entries(info, ws, Some(&self.slot), |i, j, v| reduced.set(i, j, v));
         let ratio = self.reduced.factor();
-        if ratio.is_nan() || ratio <= rank_tolerance {
+        if ratio.is_nan() || ratio <= check.rank_tolerance {
             return Err(SplitFailure::Singular(ratio));
         }
         let x = &mut self.x;
@@ -636,29 +692,10 @@ impl Split {
         self.reduced.solve(x);
         let qdd = &x[..n];
 
-        // The redundant rows must be satisfied by q̈ too, relative to the accelerations
-        // at play: those of the solution and those the forces alone would give,
-        // max_j |Q_j| / M_jj (at a static equilibrium q̈ = 0 while the forces are not).
+        // X = S⁻¹ J_R J_Dᵀ (S = J_R J_Rᵀ symmetric), T_D = Xᵀ: for the least-norm
+        // multipliers below, and for the rows D near a rank drop.
         let J = &ws.jacobian;
         let row = |i: usize| &J[i * n..(i + 1) * n];
-        let forced = info
-            .mass_pattern
-            .iter()
-            .zip(&ws.mass_values)
-            .filter(|(&(r, c), &m)| r == c && m != 0.0)
-            .fold(0.0_f64, |a, (&(r, _), &m)| a.max((b[r as usize] / m).abs()));
-        let (mut residual, mut scale) = (0.0_f64, 0.0_f64);
-        for &d in &self.rows_d {
-            let jd = row(d);
-            residual = residual.max((dot(jd, qdd) - b[n + d]).abs());
-            scale = scale.max(inf_norm(jd) * (inf_norm(qdd) + forced) + b[n + d].abs());
-        }
-        if residual.is_nan() || residual > redundant_tolerance * scale.max(f64::MIN_POSITIVE) {
-            return Err(SplitFailure::Inconsistent(residual));
-        }
-
-        // Least-norm multipliers: T_D = J_D J_Rᵀ (J_R J_Rᵀ)⁻¹, λ = T (TᵀT)⁻¹ λ_R. With
-        // X = S⁻¹ J_R J_Dᵀ (S = J_R J_Rᵀ symmetric), T_D = Xᵀ and TᵀT = I + X Xᵀ.
         let rows_r = &self.rows_r;
         for (a, &ra) in rows_r.iter().enumerate() {
             for (c, &rc) in rows_r.iter().enumerate() {
@@ -673,6 +710,72 @@ impl Split {
             self.gram.solve(column);
         }
         let xt = &self.xt;
+
+        // The redundant rows must be satisfied by q̈ too, relative to the accelerations
+        // at play: those of the solution and those the forces alone would give,
+        // max_j |Q_j| / M_jj (at a static equilibrium q̈ = 0 while the forces are not).
+        let forced = info
+            .mass_pattern
+            .iter()
+            .zip(&ws.mass_values)
+            .filter(|(&(r, c), &m)| r == c && m != 0.0)
+            .fold(0.0_f64, |a, (&(r, _), &m)| a.max((b[r as usize] / m).abs()));
+        let (mut residual, mut scale) = (0.0_f64, 0.0_f64);
+        for &d in &self.rows_d {
+            let jd = row(d);
+            residual = residual.max((dot(jd, qdd) - b[n + d]).abs());
+            scale = scale.max(inf_norm(jd) * (inf_norm(qdd) + forced) + b[n + d].abs());
+        }
+        let bound = check.redundant_tolerance * scale.max(f64::MIN_POSITIVE);
+        let strict = !residual.is_nan() && residual <= bound;
+        if check.kept || !strict {
+            // What each row of D adds to the rows R, w_d = J_d − T_d J_R, against the
+            // rank rule, and the first-order bound of its residual.
+            let rate = check.velocities.map_or(0.0, |v| {
+                let gamma = b[n..].iter().fold(0.0_f64, |a, g| a.max(g.abs()));
+                if v.speed > 0.0 {
+                    gamma / v.speed
+                } else {
+                    0.0
+                }
+            });
+            let mut consistent = !residual.is_nan();
+            for (k, &d) in self.rows_d.iter().enumerate() {
+                let jd = row(d);
+                let t_d = &xt[k * r..(k + 1) * r];
+                self.w.copy_from_slice(jd);
+                for (&c, &ra) in t_d.iter().zip(rows_r) {
+                    for (w, a) in self.w.iter_mut().zip(row(ra)) {
+                        *w -= c * a;
+                    }
+                }
+                let distance = dot(&self.w, &self.w).sqrt();
+                let size = dot(jd, jd).sqrt();
+                if check.kept && distance > INDEPENDENT * crate::RANK_PIVOT * size {
+                    return Err(SplitFailure::Independent(residual));
+                }
+                if strict {
+                    continue;
+                }
+                let allowance = check.velocities.map_or(0.0, |v| {
+                    let vr: f64 = t_d
+                        .iter()
+                        .zip(rows_r)
+                        .map(|(c, &ra)| c * v.residuals[ra])
+                        .sum();
+                    let t1: f64 = t_d.iter().map(|c| c.abs()).sum();
+                    let floor = f64::EPSILON.sqrt() * size;
+                    2.0 * RANK_DROP_SAFETY * rate * (1.0 + t1) * (v.residuals[d] - vr).abs()
+                        / distance.max(floor)
+                });
+                consistent &= (dot(jd, qdd) - b[n + d]).abs() <= bound + allowance;
+            }
+            if !consistent {
+                return Err(SplitFailure::Inconsistent(residual));
+            }
+        }
+
+        // Least-norm multipliers: λ = T (TᵀT)⁻¹ λ_R with T_D = Xᵀ and TᵀT = I + X Xᵀ.
         for a in 0..r {
             for c in 0..r {
                 let xx: f64 = xt.chunks_exact(r).map(|col| col[a] * col[c]).sum();

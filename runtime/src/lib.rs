@@ -89,7 +89,9 @@ pub use mechanism::{
     AugmentedSolve, Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint,
     JointKind, Mechanism, Parameter, Pattern, Point, Symbol, TimeDependence,
 };
-pub use partition::{Condition, Partition, PartitionError, PartitionParams, Preferences, Role};
+pub use partition::{
+    Condition, Partition, PartitionError, PartitionParams, Preferences, Role, RANK_PIVOT,
+};
 pub use pose::{isometry2_from_raw, isometry_from_raw, quaternion_from_raw, PoseExt};
 pub use reactions::{
     ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,

@@ -29,6 +29,24 @@ use crate::linalg::elimination::{Elimination, Tier};
 use crate::workspace::{check_state, EvalError, Workspace};
 use crate::{Info, Mechanism};
 
+/// The rank rule shared by the analyses of a model with redundant constraints: a row
+/// of $J$ (rows scaled to a largest entry near 1) counts as dependent on the others
+/// when what it adds to them, the pivot complete pivoting finds for it or its distance
+/// to their span, is below `RANK_PIVOT` times its size.
+///
+/// It decides which rows the projections and the chart keep ([`crate::sim`]: the
+/// re-partition of the kept rows, whose Gram matrices therefore keep pivot ratios
+/// above about `RANK_PIVOT`², far above the singular test of `SINGULAR_RATIO`), and
+/// which rows the augmented solve drops ([`crate::DynamicsParams::rank_tolerance`]'s
+/// default is `RANK_PIVOT`²: the constraint block of the augmented matrix has the
+/// squares of $J$'s pivots). Near a configuration where $C_q$ loses rank while the
+/// solution set stays smooth (the parallelogram's flat position), the rows that turn
+/// dependent are dropped by every analysis at the same distance, and taken back by
+/// every analysis when the motion leaves it. Between $10^{-8}$ (the chart's maps lose
+/// half the digits) and $10^{-3}$ (the dropped rows' own reactions start to matter,
+/// ARCHITECTURE.md, "Through a rank drop"): $10^{-5}$.
+pub const RANK_PIVOT: f64 = 1e-5;
+
 /// Tuning of Algorithm P.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PartitionParams {

@@ -142,7 +142,8 @@ impl Maps {
         self.rows_h = p.rows_h;
         let (n, r, m) = (p.q.len(), p.rows_h, p.rows.len());
         if self.position_map.len() != n * r || self.velocity_map.len() != m * m {
-            // Assembly dropped redundant rows (allocates, once).
+            // Assembly dropped redundant rows, or the rows kept changed in number near a
+            // rank drop of C_q (allocates).
             self.position_map = vec![0.0; n * r];
             self.velocity_map = vec![0.0; m * m];
         }

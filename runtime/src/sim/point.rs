@@ -16,13 +16,13 @@
 //! Nothing allocates after [`Point::new`] (except when building an error).
 
 use super::error::{SimErrorKind, SingularMatrix};
-use crate::dynamics::{Dynamics, DynamicsParams, SolverPath};
+use crate::dynamics::{Dynamics, DynamicsParams, SolverPath, Velocities};
 use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::inf_norm;
 use crate::linalg::small::{gram_cholesky_planned, GramPlan, SmallCholesky};
 use crate::scale;
 use crate::workspace::{all_finite, EvalError, Workspace};
-use crate::{Error, Info, Mechanism, NewtonParams};
+use crate::{Error, Info, Mechanism, NewtonParams, RANK_PIVOT};
 
 /// Pivot ratio below which a projection matrix $J J^\mathsf{T}$ counts as singular.
 pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
@@ -211,6 +211,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     pub factorizations: u64,
     /// Constraints the augmented solve found redundant so far.
     pub redundant: Vec<&'static str>,
+    /// The most holonomic rows the projections kept (the rank of $C_q$ at assembly);
+    /// more than `rows_h` while the motion is near a rank drop (see
+    /// [`project_positions`](Self::project_positions), which takes the rows back).
+    rank: usize,
 }
 
 impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
@@ -255,6 +259,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             factorizations: 0,
             redundant: Vec::new(),
             constraints_with_terms: false,
+            rank: 0,
         };
         point.plan_grams();
         Ok(point)
@@ -324,10 +329,10 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.rows.extend_from_slice(holonomic);
         self.rows.extend(mh..mh + nnh);
         self.rows_h = holonomic.len();
-        if self.rows_h != mh {
-            self.lu_h = SmallCholesky::new(self.rows_h);
-            self.lu_v = SmallCholesky::new(self.rows.len());
-        }
+        self.rank = self.rank.max(self.rows_h);
+        // Within the capacity of `Point::new` (every row): no allocation.
+        self.lu_h.resize(self.rows_h);
+        self.lu_v.resize(self.rows.len());
         self.plan_grams();
     }
 
@@ -369,7 +374,15 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// when there are any: which rows of a dependent set are independent changes along
     /// the motion (the three pin_y rows of the parallelogram become dependent at the
     /// bottom of its swing, and a set that dropped a pin_x row turns singular there).
-    /// Returns whether the rows were renewed (the rank of $C_q$ unchanged).
+    ///
+    /// The rows are chosen by Algorithm P with the shared rank rule
+    /// ([`crate::RANK_PIVOT`]), so the rank may change: near a configuration where
+    /// $C_q$ loses rank (the parallelogram's flat position, where the three pin_x rows
+    /// coincide) more rows are dropped; while fewer rows are kept than at assembly,
+    /// [`project_positions`](Self::project_positions) chooses them anew at each kept
+    /// state (one Algorithm P per kept state, on the few steps near the rank drop), so
+    /// they are taken back when the motion leaves it. Returns whether the rows were
+    /// renewed.
     pub fn refit(&mut self, t: f64) -> bool {
         let redundant = self
             .kin
@@ -378,12 +391,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if !redundant {
             return false;
         }
-        let rank = self.rows_h;
         self.position_factor = false;
+        let params = self.kin.params.partition;
+        self.kin.params.partition.pivot_tolerance = params.pivot_tolerance.max(RANK_PIVOT);
         let ok = self
             .kin
             .repartition(self.mech, &mut self.ws, t, &self.q)
-            .is_ok_and(|p| p.holonomic_rows().len() == rank);
+            .is_ok_and(|p| !p.holonomic_rows().is_empty());
+        self.kin.params.partition = params;
         // Algorithm P evaluated J into the workspace itself.
         self.invalidate();
         if ok {
@@ -549,9 +564,27 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         }
         self.dynamics_terms_at(t, (position, state), self.constraints_with_terms)?;
         self.factorizations += 1;
+        // A model with redundant constraints gives the solve the velocity residuals,
+        // for its check of the rows that are dependent only near a rank drop.
+        let redundant = self.rank > 0 && self.rank < self.info.nh();
+        if redundant {
+            self.velocity_residuals(t)
+                .map_err(SimErrorKind::from_eval)?;
+        }
+        let velocities = redundant.then(|| Velocities {
+            residuals: &self.vel,
+            speed: inf_norm(&self.qd),
+        });
         let stats = self
             .dynamics
-            .solve_evaluated(self.mech, &mut self.ws, t, shift, &mut self.solution)
+            .solve_evaluated(
+                self.mech,
+                &mut self.ws,
+                t,
+                shift,
+                velocities,
+                &mut self.solution,
+            )
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
@@ -813,8 +846,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let n = self.info.nq();
         let eval = SimErrorKind::from_eval;
         let tol = self.newton.tolerance;
-        // One renewal of the dropped redundant rows per projection (see `refit`).
-        let mut refitted = false;
+        // One renewal of the dropped redundant rows per projection (see `refit`); the
+        // rows dropped near a rank drop are taken back first when it is left.
+        let mut refitted = self.rows_h < self.rank && self.refit(t);
         self.position_factor = false;
         if self.rows_h > 0 {
             let mut iterations = 0;

@@ -50,3 +50,174 @@ fn parallelogram_simulates_with_projection_and_partitioning() {
         assert!(m.max_energy_drift.unwrap() < 1e3 * rtol);
     }
 }
+
+/// The crank angle of the parallelogram from its one-degree-of-freedom equation, the
+/// reference of the runs through the flat configurations: on the motion $\varphi = 0$,
+/// $x = l\cos\theta$, $y = l\sin\theta$, so the model's energies
+/// (models/src/parallelogram.rs) reduce to $T = \frac12(m_k + m_c)l^2\dot\theta^2$ and
+/// $V = (\frac32 m_k + m_c)gl\sin\theta$, and
+/// $\ddot\theta = -\frac{(3m_k/2 + m_c)\,g}{(m_k + m_c)\,l}\cos\theta$. Integrated by
+/// classical Runge–Kutta with $h = 10^{-5}$ (error $O(h^4)$, below $10^{-13}$ here:
+/// $\theta(2) = -0.52337739598091$ against $-0.5233773959809127$ from SciPy's DOP853 at
+/// rtol $10^{-14}$).
+fn crank_angle(theta0: f64, omega0: f64, t_end: f64) -> (f64, f64) {
+    let (mk, mc, l, g) = (1.0, 2.0, 0.5, 9.81);
+    let k = (1.5 * mk + mc) * g / ((mk + mc) * l);
+    let f = |th: f64, w: f64| (w, -k * th.cos());
+    let steps = (t_end / 1e-5).round() as usize;
+    let h = t_end / steps as f64;
+    let (mut th, mut w) = (theta0, omega0);
+    for _ in 0..steps {
+        let k1 = f(th, w);
+        let k2 = f(th + 0.5 * h * k1.0, w + 0.5 * h * k1.1);
+        let k3 = f(th + 0.5 * h * k2.0, w + 0.5 * h * k2.1);
+        let k4 = f(th + h * k3.0, w + h * k3.1);
+        th += h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+        w += h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+    }
+    (th, w)
+}
+
+#[test]
+fn parallelogram_runs_through_its_flat_configurations() {
+    // The default state (θ = π/3 turning at 1 rad/s) swings over the top: the cranks
+    // pass the flat configurations θ = 0 (t ≈ 0.497) and θ = −π (t ≈ 0.880), where the
+    // three pin_x rows coincide and C_q has rank 4 instead of 5 while the solution set
+    // stays one smooth curve. Every analysis drops the rows the shared rank rule calls
+    // dependent there and takes them back after (ARCHITECTURE.md, "Through a rank
+    // drop"). Loose and tight tolerances, both formulations, every adaptive integrator.
+    let model = parallelogram::Model::default();
+    let (theta, omega) = crank_angle(std::f64::consts::FRAC_PI_3, 1.0, 2.0);
+    assert!((theta - -0.523_377_395_980_912_7).abs() < 1e-12, "{theta}");
+    for (form, method, rtol) in [Formulation::Projection, Formulation::Partitioning]
+        .into_iter()
+        .flat_map(|f| Method::ADAPTIVE.map(|m| (f, m)))
+        .flat_map(|(f, m)| [(f, m, 1e-4), (f, m, 1e-8), (f, m, 1e-12)])
+    {
+        let run = Simulation::new(&model)
+            .formulation(form)
+            .integrator(method)
+            .tolerances(rtol, rtol)
+            .run(2.0)
+            .unwrap_or_else(|e| panic!("{} {} {rtol:.0e}: {e}", form.name(), method.name()));
+        let last = run.trajectory.len() - 1;
+        let (q, qd) = (run.trajectory.q(last), run.trajectory.qd(last));
+        let (e_theta, e_omega) = ((q[1] - theta).abs(), (qd[1] - omega).abs());
+        let drift = run.monitors.max_energy_drift.unwrap();
+        eprintln!(
+            "{} {} {rtol:.0e}: θ error {e_theta:.1e}, θ' error {e_omega:.1e}, energy drift {drift:.1e}, φ {:.1e}, re-partitions {}",
+            form.name(),
+            method.name(),
+            q[5],
+            run.stats.repartitions
+        );
+        // The error is the integrator's, down to a floor of about 1e-8 set by the
+        // rank drop itself: there C_q fixes φ only to the square root of the Newton
+        // tolerance (ARCHITECTURE.md).
+        let bound = 1e3 * rtol + 5e-8;
+        assert!(
+            e_theta < bound && e_omega < 3.0 * bound,
+            "{e_theta:e} {e_omega:e}"
+        );
+        assert!(drift < bound * 15.0, "{drift:e}");
+        assert!(q[5].abs() < 1e-9, "φ = {:e}", q[5]);
+    }
+}
+
+/// The parallelogram with a longer third crank whose pivot is raised so that the three
+/// cranks meet the coupler when upright: at θ = π/2 the three pin_y rows are dependent
+/// (rank 5 of 6), but the motion the velocities start is not possible (the cranks turn
+/// at ẋ/l and ẋ/l₃, and the pin_y rows' accelerations then ask for ÿ = −ẋ²/l and
+/// ÿ = −ẋ²/l₃): the mechanism locks, and the redundant rows are inconsistent.
+#[pfaff::mechanism]
+pub mod locked_parallelogram {
+    const l: f64 = 0.5;
+    const l3: f64 = 0.6;
+    const d: f64 = 0.4;
+    const mk: f64 = 1.0;
+    const mc: f64 = 2.0;
+    const g: f64 = 9.81;
+
+    static th1: Coordinate = Coordinate {};
+    static th2: Coordinate = Coordinate {};
+    static th3: Coordinate = Coordinate {};
+    static x: Coordinate = Coordinate {};
+    static y: Coordinate = Coordinate {};
+    static phi: Coordinate = Coordinate {};
+
+    fn kinetic_energy() -> f64 {
+        0.5 * (mk * l * l / 3.0) * (th1.dot().powi(2) + th2.dot().powi(2))
+            + 0.5 * (mk * l3 * l3 / 3.0) * th3.dot().powi(2)
+            + 0.5 * mc * (x.dot().powi(2) + y.dot().powi(2))
+            + 0.5 * (mc * 4.0 * d * d / 12.0) * phi.dot().powi(2)
+    }
+
+    fn potential_energy() -> f64 {
+        mk * g * 0.5 * (l * th1.sin() + l * th2.sin() + l3 * th3.sin()) + mc * g * y
+    }
+
+    #[holonomic]
+    fn pin1_x() -> f64 {
+        x - d * phi.cos() + d - l * th1.cos()
+    }
+
+    #[holonomic]
+    fn pin1_y() -> f64 {
+        y - d * phi.sin() - l * th1.sin()
+    }
+
+    #[holonomic]
+    fn pin2_x() -> f64 {
+        x - l * th2.cos()
+    }
+
+    #[holonomic]
+    fn pin2_y() -> f64 {
+        y - l * th2.sin()
+    }
+
+    #[holonomic]
+    fn pin3_x() -> f64 {
+        x + d * phi.cos() - d - l3 * th3.cos()
+    }
+
+    #[holonomic]
+    fn pin3_y() -> f64 {
+        y + d * phi.sin() - (l - l3) - l3 * th3.sin()
+    }
+}
+
+#[test]
+fn an_inconsistent_redundant_set_is_still_an_error() {
+    use pfaff::sim::SimErrorKind;
+    let model = locked_parallelogram::Model::default();
+    let (l, l3) = (0.5, 0.6);
+    let h = std::f64::consts::FRAC_PI_2;
+    let q0 = [h, h, h, 0.0, l, 0.0];
+    // ẋ = −l: the cranks' tips move along x only, θ̇ᵢ = −ẋ/lᵢ.
+    let qd0 = [1.0, 1.0, l / l3, -l, 0.0, 0.0];
+    for form in [Formulation::Projection, Formulation::Partitioning] {
+        for rtol in [1e-4, 1e-12] {
+            let err = Simulation::new(&model)
+                .formulation(form)
+                .initial_state(&q0, &qd0)
+                .tolerances(rtol, rtol)
+                .run(0.1)
+                .unwrap_err();
+            eprintln!("{} {rtol:.0e}: {err}", form.name());
+            let SimErrorKind::Analysis(pfaff::Error::Dynamics(
+                pfaff::DynamicsError::InconsistentRedundant {
+                    ref constraints,
+                    residual,
+                    ..
+                },
+            )) = err.kind
+            else {
+                panic!("{}: {err}", form.name());
+            };
+            assert!(!constraints.is_empty() && constraints.iter().all(|c| c.ends_with("_y")));
+            // ẋ²|1/l − 1/l₃| = 0.0833 m/s², of order 1 against the tolerance.
+            assert!(residual > 1e-2, "{residual:e}");
+        }
+    }
+}
