@@ -541,6 +541,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         }
         let velocities = redundant.then(|| Velocities {
             residuals: &self.vel,
+            qd: &self.qd,
             speed: inf_norm(&self.qd),
         });
         let stats = self
