@@ -76,6 +76,43 @@ fn dop853_counts_with_and_without_dense_output() {
     }
 }
 
+/// DOPRI5's interpolant costs no evaluation, only a pass over the stages: without
+/// `dense_output` (or on a step short of `dense_output_from`) the pass is skipped, the
+/// steps are bitwise those with it, and `interpolate` says the interpolant is missing.
+#[test]
+fn dopri5_prepares_its_interpolant_only_when_asked() {
+    let mut sys = Kepler { e: 0.5 };
+    let y0 = sys.y0();
+    let run = |dense: bool, from: Option<f64>, sys: &mut Kepler| {
+        let o = OdeOptions {
+            dense_output: dense,
+            ..OdeOptions::with_tol(1e-9)
+        };
+        let mut ode = Dopri5::new(4, o).unwrap();
+        ode.dense_output_from(from);
+        ode.reset(sys, 0.0, &y0, None).unwrap();
+        ode.integrate_to(sys, PI).unwrap();
+        let mut out = [0.0; 4];
+        let interpolates = ode.interpolate(ode.t(), &mut out).is_ok();
+        (ode.y().to_vec(), *ode.stats(), interpolates, out)
+    };
+    let (y_dense, s_dense, yes, out) = run(true, None, &mut sys);
+    let (y_bare, s_bare, no, _) = run(false, None, &mut sys);
+    let (y_late, _, late, _) = run(true, Some(2.0 * PI), &mut sys);
+    assert!(yes && !no && !late);
+    // At the end of the step the interpolant is the state, r1 + r2 = y_{n+1} (up to
+    // the rounding of y + (y_{n+1} - y)).
+    for (o, y) in out.iter().zip(&y_dense) {
+        assert!((o - y).abs() <= 1e-14 * (1.0 + y.abs()), "{o} against {y}");
+    }
+    assert_eq!(y_dense, y_bare);
+    assert_eq!(y_dense, y_late);
+    assert_eq!(
+        (s_dense.steps, s_dense.rejected, s_dense.rhs_evals),
+        (s_bare.steps, s_bare.rejected, s_bare.rhs_evals)
+    );
+}
+
 #[test]
 fn adams_is_pece() {
     let mut sys = Kepler { e: 0.5 };

@@ -2,8 +2,9 @@
 //! Hairer's `dopri5.f`.
 //!
 //! Input: an [`OdeSystem`], [`OdeOptions`], an initial state. Output: one accepted step
-//! per call, advanced with the fifth-order solution (local extrapolation), and Hairer's
-//! fourth-order continuous extension on it (no extra evaluation).
+//! per call, advanced with the fifth-order solution (local extrapolation), and (when
+//! `dense_output`) Hairer's fourth-order continuous extension on it (no extra
+//! evaluation, a pass over the stages).
 //! Invariants: FSAL, i.e. the seventh stage $f(t+h, y_{n+1})$ is the first stage of the
 //! next step, so an attempt costs 6 evaluations and reset costs 1 (plus 1 for the
 //! automatic initial step size); no allocation after construction.
@@ -67,9 +68,16 @@ pub struct Dopri5(RkDriver<Dp5>);
 /// The stages and the interpolant of DOPRI5.
 #[derive(Clone, Debug)]
 pub(crate) struct Dp5 {
+    /// Whether `cont` describes the last step.
+    dense_ready: bool,
+    /// With `dense_output`, the interpolant is prepared only on the steps that reach
+    /// this time (every step when `None`), see [`Dopri5::dense_output_from`].
+    dense_from: Option<f64>,
+    /// Stage derivatives 1–7 (index = stage − 1).
     k: [Vec<f64>; 7],
-    /// Coefficients of the interpolant on the last step (`rcont1..5` of dopri5.f).
-    cont: [Vec<f64>; 5],
+    /// Coefficients of the interpolant on the last step (`rcont1..5` of dopri5.f),
+    /// row `r` at `r * n..(r + 1) * n`.
+    cont: Vec<f64>,
 }
 
 impl Dopri5 {
@@ -78,11 +86,12 @@ impl Dopri5 {
     /// # Errors
     /// Invalid options, see [`OdeOptions::validate`].
     pub fn new(dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
-        let v = || vec![0.0; dim];
         let ctrl = PiController::new(0.2 - 0.04 * 0.75, 0.04, 0.9, 0.2, 10.0);
         let m = Dp5 {
-            k: std::array::from_fn(|_| v()),
-            cont: std::array::from_fn(|_| v()),
+            dense_ready: false,
+            dense_from: None,
+            k: std::array::from_fn(|_| vec![0.0; dim]),
+            cont: vec![0.0; 5 * dim],
         };
         RkDriver::new(dim, opts, ctrl, m).map(Self)
     }
@@ -91,6 +100,21 @@ impl Dopri5 {
     pub fn options(&self) -> &OdeOptions {
         &self.0.st.opts
     }
+
+    /// With `dense_output` on, prepares the interpolant (a pass over the stages, no
+    /// evaluation) only on the accepted steps that reach `t` in the direction of
+    /// integration; `None` (the default): on every step. As
+    /// [`Dop853::dense_output_from`](super::Dop853::dense_output_from).
+    pub fn dense_output_from(&mut self, t: Option<f64>) {
+        self.0.method_mut().dense_from = t;
+    }
+}
+
+/// The stages of `k`, each cut to length `n` (so that the loops over `0..n`
+/// index them without bounds checks).
+#[inline]
+fn cut<const S: usize>(k: &mut [Vec<f64>; S], n: usize) -> [&mut [f64]; S] {
+    k.each_mut().map(|k| &mut k[..n])
 }
 
 impl EmbeddedRk for Dp5 {
@@ -108,37 +132,38 @@ impl EmbeddedRk for Dp5 {
         sys: &mut S,
         h: f64,
     ) -> Result<f64, OdeError> {
-        let (t, y, tmp) = (st.t, &st.y, &mut st.tmp);
-        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        let n = st.y.len();
+        let (t, y, tmp) = (st.t, &st.y[..n], &mut st.tmp[..n]);
+        let [k1, k2, k3, k4, k5, k6, k7] = cut(&mut self.k, n);
         let stats = &mut st.stats;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] = y[i] + h * A21 * k1[i];
         }
         eval(sys, stats, t + C2 * h, tmp, k2)?;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
         }
         eval(sys, stats, t + C3 * h, tmp, k3)?;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
         }
         eval(sys, stats, t + C4 * h, tmp, k4)?;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
         }
         eval(sys, stats, t + C5 * h, tmp, k5)?;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] =
                 y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
         }
         eval(sys, stats, t + h, tmp, k6)?;
-        let y_new = &mut st.y_new;
-        for i in 0..y.len() {
+        let y_new = &mut st.y_new[..n];
+        for i in 0..n {
             y_new[i] =
                 y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
         }
         eval(sys, stats, t + h, y_new, k7)?;
-        for i in 0..y.len() {
+        for i in 0..n {
             tmp[i] =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         }
@@ -148,19 +173,30 @@ impl EmbeddedRk for Dp5 {
         Ok(rms_norm(&st.opts.tol, tmp, y, y_new))
     }
 
-    /// Stores the interpolant of the accepted step; the FSAL stage `k[6]` is there
+    /// With `dense_output` (on a step that reaches [`dense_from`](Self::dense_from)),
+    /// stores the interpolant of the accepted step; the FSAL stage `k[6]` is there
     /// already, so this cannot fail.
     fn accept<S: OdeSystem + ?Sized>(
         &mut self,
         st: &mut RkState,
         _sys: &mut S,
         h: f64,
-        _t_new: f64,
+        t_new: f64,
     ) -> Result<(), OdeError> {
-        let [k1, _, k3, k4, k5, k6, k7] = &self.k;
-        let [c1, c2, c3, c4, c5] = &mut self.cont;
-        let (y, y_new) = (&st.y, &st.y_new);
-        for i in 0..y.len() {
+        let wanted = self.dense_from.is_none_or(|td| (t_new - td) * h >= 0.0);
+        self.dense_ready = st.opts.dense_output && wanted;
+        if !self.dense_ready {
+            return Ok(());
+        }
+        let n = st.y.len();
+        let [k1, _, k3, k4, k5, k6, k7] = cut(&mut self.k, n);
+        let (c1, c) = self.cont.split_at_mut(n);
+        let (c2, c) = c.split_at_mut(n);
+        let (c3, c) = c.split_at_mut(n);
+        let (c4, c5) = c.split_at_mut(n);
+        let c5 = &mut c5[..n];
+        let (y, y_new) = (&st.y[..n], &st.y_new[..n]);
+        for i in 0..n {
             let ydiff = y_new[i] - y[i];
             let bspl = h * k1[i] - ydiff;
             c1[i] = y[i];
@@ -173,10 +209,18 @@ impl EmbeddedRk for Dp5 {
         Ok(())
     }
 
+    fn forget_dense(&mut self) {
+        self.dense_ready = false;
+    }
+
     fn dense(&self, th: f64, out: &mut [f64]) -> Result<(), OdeError> {
+        if !self.dense_ready {
+            return Err(OdeError::DenseOutputUnavailable);
+        }
         let th1 = 1.0 - th;
-        let [c1, c2, c3, c4, c5] = &self.cont;
-        for i in 0..out.len() {
+        let n = out.len();
+        let [c1, c2, c3, c4, c5] = std::array::from_fn(|r| &self.cont[r * n..][..n]);
+        for i in 0..n {
             out[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
         }
         Ok(())

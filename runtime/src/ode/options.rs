@@ -112,8 +112,11 @@ pub struct OdeOptions {
     pub h_max: f64,
     /// Largest number of step attempts, accepted and rejected, between two resets.
     pub max_steps: u64,
-    /// Whether to prepare dense output on every step. Only [`Dop853`](super::Dop853)
-    /// pays for it (three extra evaluations per step); the others always have it.
+    /// Whether to prepare dense output on every step. [`Dop853`](super::Dop853) pays
+    /// three extra evaluations per step for it, [`Dopri5`](super::Dopri5) a pass over
+    /// its stages; without it their [`interpolate`](super::Integrator::interpolate)
+    /// fails with [`OdeError::DenseOutputUnavailable`](super::OdeError). The others
+    /// always have it.
     pub dense_output: bool,
 }
 

@@ -71,12 +71,14 @@ impl Stepper {
         each!(self, i => i.interpolate(t, out))
     }
 
-    /// DOP853 prepares its interpolant only on the steps that reach `t` (see
-    /// [`Dop853::dense_output_from`]); the other methods have it on every step at no
-    /// cost.
+    /// DOP853 and DOPRI5 prepare their interpolants only on the steps that reach `t`
+    /// (see [`Dop853::dense_output_from`], [`Dopri5::dense_output_from`]); the other
+    /// methods have theirs on every step at no cost.
     pub fn dense_output_from(&mut self, t: Option<f64>) {
-        if let Self::Dop853(i) = self {
-            i.dense_output_from(t);
+        match self {
+            Self::Dop853(i) => i.dense_output_from(t),
+            Self::Dopri5(i) => i.dense_output_from(t),
+            _ => {}
         }
     }
 

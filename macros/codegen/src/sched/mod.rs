@@ -25,6 +25,7 @@ mod runs;
 use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;
 
+use crate::sym::transform::post_order_by;
 use crate::sym::{ExprId, Func, Graph, Node, Var};
 
 pub use runs::{Run, MIN_RUN};
@@ -176,41 +177,21 @@ fn live_order(
     runs: &mut HashMap<ExprId, (Vec<Run>, Vec<ExprId>)>,
     sums: &HashMap<ExprId, AngleSum>,
 ) -> Vec<ExprId> {
-    let mut seen = vec![false; g.len()];
-    let mut order = Vec::new();
-    let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
-    while let Some((id, expanded)) = stack.pop() {
-        if expanded {
-            order.push(id);
-            continue;
-        }
-        if seen[id.index()] {
-            continue;
-        }
-        seen[id.index()] = true;
-        stack.push((id, true));
-        let kids = match g.node(id) {
-            _ if sums.contains_key(&id) => sums[&id].operands().to_vec(),
-            Node::Add(terms) if !slots.is_empty() => match runs.get(&id) {
-                Some((_, rest)) => rest.clone(),
-                None => match runs::find(g, terms, slots) {
-                    Some((r, rest)) => {
-                        let kids = rest.clone();
-                        runs.insert(id, (r, rest));
-                        kids
-                    }
-                    None => terms.to_vec(),
-                },
+    post_order_by(g, roots, |id, node| match node {
+        _ if sums.contains_key(&id) => sums[&id].operands().to_vec(),
+        Node::Add(terms) if !slots.is_empty() => match runs.get(&id) {
+            Some((_, rest)) => rest.clone(),
+            None => match runs::find(g, terms, slots) {
+                Some((r, rest)) => {
+                    let kids = rest.clone();
+                    runs.insert(id, (r, rest));
+                    kids
+                }
+                None => terms.to_vec(),
             },
-            node => node.args(),
-        };
-        for a in kids.into_iter().rev() {
-            if !seen[a.index()] {
-                stack.push((a, false));
-            }
-        }
-    }
-    order
+        },
+        node => node.args(),
+    })
 }
 
 /// `sin(a ± b)` and `cos(a ± b)` from the pairs of `a` and `b`:

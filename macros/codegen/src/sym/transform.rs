@@ -9,6 +9,16 @@ use super::graph::{ExprId, Graph, Node, Var};
 
 /// Post-order of the nodes reachable from `roots` (operands before users), each once.
 pub fn post_order(g: &Graph, roots: &[ExprId]) -> Vec<ExprId> {
+    post_order_by(g, roots, |_, node| node.args())
+}
+
+/// [`post_order`] with the operands of each node given by `operands(id, node)` (a
+/// schedule that reads some nodes through others).
+pub fn post_order_by(
+    g: &Graph,
+    roots: &[ExprId],
+    mut operands: impl FnMut(ExprId, &Node) -> Vec<ExprId>,
+) -> Vec<ExprId> {
     let mut seen = vec![false; g.len()];
     let mut order = Vec::new();
     let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
@@ -22,7 +32,7 @@ pub fn post_order(g: &Graph, roots: &[ExprId]) -> Vec<ExprId> {
         }
         seen[id.index()] = true;
         stack.push((id, true));
-        for a in g.node(id).args().into_iter().rev() {
+        for a in operands(id, g.node(id)).into_iter().rev() {
             if !seen[a.index()] {
                 stack.push((a, false));
             }
