@@ -568,11 +568,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
         if redundant {
-            self.velocity_residuals(t)
-                .map_err(SimErrorKind::from_eval)?;
+            self.redundant_velocity_residuals(t)?;
         }
         let velocities = redundant.then(|| Velocities {
             residuals: &self.vel,
+            qd: &self.qd,
             speed: inf_norm(&self.qd),
         });
         let stats = self
@@ -597,6 +597,15 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.redundant.extend(self.dynamics.redundant_constraints());
         }
         Ok(())
+    }
+
+    /// [`velocity_residuals`](Self::velocity_residuals) for the solve of a model with
+    /// redundant constraints, out of line: the solve of every other model does not
+    /// carry it.
+    #[cold]
+    #[inline(never)]
+    fn redundant_velocity_residuals(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        self.velocity_residuals(t).map_err(SimErrorKind::from_eval)
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
