@@ -294,6 +294,8 @@ enum SplitFailure {
 pub(crate) struct Velocities<'a> {
     /// $v = J\dot q + [C_t; g]$, every row.
     pub residuals: &'a [f64],
+    /// $\dot q$.
+    pub qd: &'a [f64],
     /// $\lVert\dot q\rVert_\infty$.
     pub speed: f64,
 }
@@ -758,15 +760,29 @@ impl Split {
                     continue;
                 }
                 let allowance = check.velocities.map_or(0.0, |v| {
-                    let vr: f64 = t_d
-                        .iter()
-                        .zip(rows_r)
-                        .map(|(c, &ra)| c * v.residuals[ra])
-                        .sum();
+                    // v_d − T_d v_R and w_d less their round-off (32 ε times the sums of
+                    // the magnitudes they are made of): a row dependent at every
+                    // configuration has both at round-off and no allowance.
+                    let (mut vr, mut v_size, mut w_size) = (v.residuals[d], 0.0, size);
+                    for (c, &ra) in t_d.iter().zip(rows_r) {
+                        vr -= c * v.residuals[ra];
+                        v_size += c.abs() * v.residuals[ra].abs();
+                        w_size += c.abs() * dot(row(ra), row(ra)).sqrt();
+                    }
+                    let rounding = 32.0 * f64::EPSILON;
+                    let products = |i: usize| -> f64 {
+                        row(i).iter().zip(v.qd).map(|(a, q)| (a * q).abs()).sum()
+                    };
+                    v_size += products(d)
+                        + t_d
+                            .iter()
+                            .zip(rows_r)
+                            .map(|(c, &ra)| c.abs() * products(ra))
+                            .sum::<f64>();
                     let t1: f64 = t_d.iter().map(|c| c.abs()).sum();
-                    let floor = f64::EPSILON.sqrt() * size;
-                    2.0 * RANK_DROP_SAFETY * rate * (1.0 + t1) * (v.residuals[d] - vr).abs()
-                        / distance.max(floor)
+                    let numerator = (vr.abs() - rounding * v_size).max(0.0);
+                    2.0 * RANK_DROP_SAFETY * rate * (1.0 + t1) * numerator
+                        / distance.max(rounding * w_size)
                 });
                 consistent &= (dot(jd, qdd) - b[n + d]).abs() <= bound + allowance;
             }

@@ -9,8 +9,8 @@
 //!
 //! | formulation | reconstruct | kept states | failures that reject an attempt |
 //! |---|---|---|---|
-//! | [`Partitioned`] | the point of the chart of the last accepted state | polished to the Newton tolerance; the derivative stays valid | the chart's Newton, a singular projection |
-//! | [`Projected`] | $y$ as it is | projected on $C = 0$, $J\dot q + c = 0$ | none |
+//! | [`Partitioned`] | the point of the chart of the last accepted state | polished to the Newton tolerance; the derivative stays valid | the chart's Newton, a singular projection, redundant rows inconsistent |
+//! | [`Projected`] | $y$ as it is | projected on $C = 0$, $J\dot q + c = 0$ | redundant rows inconsistent |
 //! | [`Stabilized`] | $y$ as it is | as they are | none |
 //! | [`Free`] | $y$ as it is | as they are | none |
 
@@ -90,6 +90,21 @@ pub(crate) trait Form {
 
     /// Whether a failure of the right-hand side only rejects the step attempt.
     fn recoverable(&self, e: &SimErrorKind) -> bool;
+}
+
+/// Whether `e` is the augmented solve's inconsistency of redundant rows: a failure of a
+/// trial state near a rank drop of $C_q$, off the constraints by the step's error (the
+/// first-order bound of the dropped rows' residual assumes consistent positions), is
+/// rejected like a failed Newton iteration, and a shorter step brings the stage back;
+/// a genuinely inconsistent set fails every retry and ends the run with the typed error
+/// (ARCHITECTURE.md, "Through a rank drop").
+fn inconsistent_redundant(e: &SimErrorKind) -> bool {
+    matches!(
+        e,
+        SimErrorKind::Analysis(crate::Error::Dynamics(
+            crate::DynamicsError::InconsistentRedundant { .. }
+        ))
+    )
 }
 
 /// Copies $y = [q; \dot q]$ into the state of `p` ([`Point::set_state`]).
@@ -366,7 +381,7 @@ impl Form for Partitioned {
         matches!(
             e,
             SimErrorKind::NewtonFailed { .. } | SimErrorKind::Singular { .. }
-        )
+        ) || inconsistent_redundant(e)
     }
 }
 
@@ -412,8 +427,8 @@ impl Form for Projected {
         p.project(t)
     }
 
-    fn recoverable(&self, _: &SimErrorKind) -> bool {
-        false
+    fn recoverable(&self, e: &SimErrorKind) -> bool {
+        inconsistent_redundant(e)
     }
 }
 

@@ -104,6 +104,30 @@ fn same(a: &[f64], b: &[f64]) -> bool {
     a.iter().zip(b).fold(true, |s, (x, y)| s & (x == y))
 }
 
+/// `out[r] += v * x[c]` for the entries `(r, c)` of `pattern` with the values `values`,
+/// in the pattern's order, each run of consecutive entries of one row summed in a
+/// register: the operations of the scatter in its order, bit for bit, without each
+/// `+=` waiting for the store of the one before (the patterns are by rows).
+#[inline]
+fn add_products(out: &mut [f64], pattern: &[(u32, u32)], values: &[f64], x: &[f64]) {
+    let mut entries = pattern.iter().zip(values);
+    let Some((&(r, c), v)) = entries.next() else {
+        return;
+    };
+    let mut row = r as usize;
+    let mut sum = out[row] + v * x[c as usize];
+    for (&(r, c), v) in entries {
+        let r = r as usize;
+        if r != row {
+            out[row] = sum;
+            row = r;
+            sum = out[row];
+        }
+        sum += v * x[c as usize];
+    }
+    out[row] = sum;
+}
+
 /// The version of the state a group of evaluations holds values at (0: none).
 type Stamp = u64;
 
@@ -501,14 +525,21 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
         }
-        self.vel[..mh].copy_from_slice(&self.ws.ct);
-        self.vel[mh..].copy_from_slice(&self.ws.bias);
-        for (&(r, c), v) in info.holonomic_pattern.iter().zip(&self.ws.cq_values) {
-            self.vel[r as usize] += v * self.qd[c as usize];
-        }
-        for (&(r, c), v) in info.nonholonomic_pattern.iter().zip(&self.ws.g_values) {
-            self.vel[mh + r as usize] += v * self.qd[c as usize];
-        }
+        let (holonomic, nonholonomic) = self.vel.split_at_mut(mh);
+        holonomic.copy_from_slice(&self.ws.ct);
+        nonholonomic.copy_from_slice(&self.ws.bias);
+        add_products(
+            holonomic,
+            info.holonomic_pattern,
+            &self.ws.cq_values,
+            &self.qd,
+        );
+        add_products(
+            nonholonomic,
+            info.nonholonomic_pattern,
+            &self.ws.g_values,
+            &self.qd,
+        );
         Ok(())
     }
 
@@ -537,11 +568,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
         if redundant {
-            self.velocity_residuals(t)
-                .map_err(SimErrorKind::from_eval)?;
+            self.redundant_velocity_residuals(t)?;
         }
         let velocities = redundant.then(|| Velocities {
             residuals: &self.vel,
+            qd: &self.qd,
             speed: inf_norm(&self.qd),
         });
         let stats = self
@@ -566,6 +597,15 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.redundant.extend(self.dynamics.redundant_constraints());
         }
         Ok(())
+    }
+
+    /// [`velocity_residuals`](Self::velocity_residuals) for the solve of a model with
+    /// redundant constraints, out of line: the solve of every other model does not
+    /// carry it.
+    #[cold]
+    #[inline(never)]
+    fn redundant_velocity_residuals(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        self.velocity_residuals(t).map_err(SimErrorKind::from_eval)
     }
 
     /// $M$, $Q$, $C_q$, $G$ and $\gamma$ at the current state, from one call of the
@@ -774,12 +814,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                     *d += a * mu;
                 }
             }
-            let mut step = 0.0_f64;
+            // The largest change without `f64::max` (whose NaN handling is a chain of
+            // three instructions per entry), and a flag for a non-finite one.
+            let (mut step, mut finite) = (0.0_f64, true);
             for (v, d) in self.qd.iter_mut().zip(&*dx) {
                 *v -= d;
-                step = step.max(d.abs());
+                let a = d.abs();
+                step = if a > step { a } else { step };
+                finite &= a <= f64::MAX;
             }
-            if !step.is_finite() || step >= 0.5 * previous {
+            if !finite || step >= 0.5 * previous {
                 return Ok(false);
             }
             previous = step;
@@ -982,6 +1026,33 @@ mod tests {
         }
         fn kinetic_energy(&self, _: f64, _: &[f64], qd: &[f64]) -> f64 {
             0.5 * (qd[0] * qd[0] + qd[1] * qd[1])
+        }
+    }
+
+    /// `add_products` is the scatter `out[r] += v * x[c]` bit for bit, for patterns by
+    /// rows, with rows left and entered again, and empty.
+    #[test]
+    fn add_products_is_the_scatter() {
+        let x = [0.1, -3.0, 7.0e5, 1.0 / 3.0];
+        let patterns: [&[(u32, u32)]; 4] = [
+            &[],
+            &[(0, 0), (0, 1), (0, 3), (1, 1), (2, 0), (2, 2), (2, 3)],
+            &[(1, 2), (0, 0), (0, 3), (1, 0), (1, 1), (2, 3), (0, 1)],
+            &[(2, 3)],
+        ];
+        for pattern in patterns {
+            let values: Vec<f64> = (0..pattern.len())
+                .map(|i| (1.7 * i as f64 + 0.3).sin() * 10f64.powi(i as i32 - 3))
+                .collect();
+            let start = [0.25, -1e-9, 4.0];
+            let mut expected = start;
+            for (&(r, c), v) in pattern.iter().zip(&values) {
+                expected[r as usize] += v * x[c as usize];
+            }
+            let mut out = start;
+            add_products(&mut out, pattern, &values, &x);
+            let bits = |a: &[f64; 3]| a.map(f64::to_bits);
+            assert_eq!(bits(&out), bits(&expected), "{pattern:?}");
         }
     }
 
