@@ -159,6 +159,23 @@ pub(crate) fn accumulate_finite(acc: &mut [f64; 4], x: &[f64]) {
     }
 }
 
+/// Adds every entry of `x` into the four lanes of `acc`: once an entry is NaN or
+/// infinite its lane stays NaN or infinite (finite entries may overflow a lane too).
+/// One operation per two entries, where [`accumulate_finite`] takes two; for checks
+/// whose failure only starts an exact search ([`Workspace::check_dynamics_terms`]).
+#[inline]
+pub(crate) fn accumulate_sum(acc: &mut [f64; 4], x: &[f64]) {
+    let chunks = x.chunks_exact(4);
+    for (a, v) in acc.iter_mut().zip(chunks.remainder()) {
+        *a += v;
+    }
+    for c in chunks {
+        for (a, v) in acc.iter_mut().zip(c) {
+            *a += v;
+        }
+    }
+}
+
 /// Whether every entry [`accumulate_finite`] added into `acc` was finite.
 #[inline]
 pub(crate) fn finite_lanes(acc: &[f64; 4]) -> bool {
@@ -603,6 +620,25 @@ impl Workspace {
         self.check_dynamics_terms(t)
     }
 
+    /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with) for a caller that
+    /// holds the model this workspace was made for and coordinates of its length (the
+    /// simulation's point, which builds both from the model once): without the check of
+    /// the model, a call through `dyn Mechanism` and three comparisons per evaluation.
+    #[inline]
+    pub(crate) fn eval_dynamics_terms_held<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        constraints: bool,
+    ) -> Result<(), EvalError> {
+        debug_assert!(self.check_model(mech, q, Some(qd)).is_ok());
+        let (terms, _) = self.dynamics_outputs(constraints);
+        mech.dynamics_terms(t, q, qd, terms);
+        self.check_dynamics_terms(t)
+    }
+
     /// [`eval_dynamics_terms`](Self::eval_dynamics_terms) through
     /// [`Mechanism::dynamics_terms_corrected`]: `correct(cq, g, ct, bias, qd)` may change
     /// `qd` between the position terms and the velocity terms; the rates $C_t$, $g$ it
@@ -628,9 +664,11 @@ impl Workspace {
         self.check_dynamics_terms(t)
     }
 
-    /// The finiteness checks of the dynamics terms: one branch-free pass over every
-    /// output ([`accumulate_finite`]), and the scan that names the quantity and the entry only
-    /// after it fails.
+    /// The finiteness checks of the dynamics terms: one branch-free pass that sums every
+    /// output into four lanes ([`accumulate_sum`]), and the scan that names the quantity
+    /// and the entry only after the sum is not finite. A NaN or an infinite entry
+    /// makes its lane, and so the sum, NaN or infinite for good; finite entries whose
+    /// sum overflows only cost the scan, which then finds nothing.
     #[inline]
     fn check_dynamics_terms(&self, t: f64) -> Result<(), EvalError> {
         let mut acc = [0.0; 4];
@@ -641,9 +679,9 @@ impl Workspace {
             &self.g_values,
             &self.gamma,
         ] {
-            accumulate_finite(&mut acc, x);
+            accumulate_sum(&mut acc, x);
         }
-        if finite_lanes(&acc) {
+        if ((acc[0] + acc[1]) + (acc[2] + acc[3])).is_finite() {
             Ok(())
         } else {
             self.locate_non_finite_terms(t)
@@ -868,6 +906,38 @@ mod tests {
         mech.poison.set((1, 2));
         mech.bad.set(f64::MAX);
         assert_eq!(ws.eval_dynamics_terms(&mech, 0.5, &q, &qd), Ok(()));
+    }
+
+    /// Finite terms whose sums overflow the lanes of the one-pass check pass it: the
+    /// overflow only starts the search, which finds nothing; a NaN among them is still
+    /// named.
+    #[test]
+    fn finite_terms_whose_sums_overflow_pass() {
+        let mut ws = Workspace::new(&INFO).unwrap();
+        for x in [
+            &mut ws.mass_values,
+            &mut ws.forces,
+            &mut ws.cq_values,
+            &mut ws.g_values,
+            &mut ws.gamma,
+        ] {
+            x.fill(f64::MAX);
+        }
+        let mut acc = [0.0; 4];
+        accumulate_sum(&mut acc, &ws.mass_values);
+        assert!(acc.iter().any(|a| a.is_infinite()), "the lanes overflow");
+        assert_eq!(ws.check_dynamics_terms(0.5), Ok(()));
+        ws.forces[1] = f64::NAN;
+        let err = ws.check_dynamics_terms(0.5).unwrap_err();
+        assert!(matches!(
+            err,
+            EvalError::NonFinite {
+                quantity: Quantity::Forces,
+                row: 1,
+                col: None,
+                ..
+            }
+        ));
     }
 
     /// [`all_finite`] at every position of slices longer and shorter than its four

@@ -647,7 +647,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 self.constraints = 0;
             }
             self.ws
-                .eval_dynamics_terms_with(self.mech, t, &self.q, &self.qd, with_c)
+                .eval_dynamics_terms_held(self.mech, t, &self.q, &self.qd, with_c)
                 .map_err(SimErrorKind::from_eval)?;
             self.terms = state;
             self.jacobian = position;
