@@ -148,15 +148,7 @@ impl fmt::Display for PatternDefect {
 /// per entry); [`finite_lanes`] reads the verdict.
 #[inline]
 pub(crate) fn accumulate_finite(acc: &mut [f64; 4], x: &[f64]) {
-    let chunks = x.chunks_exact(4);
-    for (a, v) in acc.iter_mut().zip(chunks.remainder()) {
-        *a += v * 0.0;
-    }
-    for c in chunks {
-        for (a, v) in acc.iter_mut().zip(c) {
-            *a += v * 0.0;
-        }
-    }
+    accumulate(acc, x, |v| v * 0.0);
 }
 
 /// Adds every entry of `x` into the four lanes of `acc`: once an entry is NaN or
@@ -165,13 +157,20 @@ pub(crate) fn accumulate_finite(acc: &mut [f64; 4], x: &[f64]) {
 /// whose failure only starts an exact search ([`Workspace::check_dynamics_terms`]).
 #[inline]
 pub(crate) fn accumulate_sum(acc: &mut [f64; 4], x: &[f64]) {
+    accumulate(acc, x, |v| v);
+}
+
+/// Adds `term(x_i)` for every entry of `x` into the four lanes of `acc`, the remainder
+/// first.
+#[inline(always)]
+fn accumulate(acc: &mut [f64; 4], x: &[f64], term: impl Fn(f64) -> f64) {
     let chunks = x.chunks_exact(4);
-    for (a, v) in acc.iter_mut().zip(chunks.remainder()) {
-        *a += v;
+    for (a, &v) in acc.iter_mut().zip(chunks.remainder()) {
+        *a += term(v);
     }
     for c in chunks {
-        for (a, v) in acc.iter_mut().zip(c) {
-            *a += v;
+        for (a, &v) in acc.iter_mut().zip(c) {
+            *a += term(v);
         }
     }
 }
