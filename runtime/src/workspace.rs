@@ -614,9 +614,7 @@ impl Workspace {
         constraints: bool,
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        let (terms, _) = self.dynamics_outputs(constraints);
-        mech.dynamics_terms(t, q, qd, terms);
-        self.check_dynamics_terms(t)
+        self.eval_dynamics_terms_held(mech, t, q, qd, constraints)
     }
 
     /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with) for a caller that
