@@ -351,7 +351,6 @@ impl Kinematics {
             .map(|(c, &v)| (c.name, v))
             .collect();
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
-        self.assemble(mech, ws, t, q, qd, prescription)?;
         let changed = |qd: &[f64], (name, v): (&'static str, f64)| {
             let i = info
                 .coordinate_index(name)
@@ -362,9 +361,14 @@ impl Kinematics {
                 used: qd[i],
             })
         };
+        let mut report = self.assemble(mech, ws, t, q, qd, prescription)?;
         let mut velocities: Vec<(&str, f64)> = prescription.velocities.to_vec();
         // The velocities of the last successful assembly.
         let mut assembled = qd.to_vec();
+        // Whether `q`, `qd`, the partition and `report` are those of the assembly with
+        // `velocities` (the assembly is a function of `q0`, `qd0` and the
+        // prescription, so a successful last trial needs no repetition).
+        let mut current = true;
         for &d in &declared {
             if changed(&assembled, d).is_none() {
                 continue;
@@ -376,21 +380,26 @@ impl Kinematics {
             };
             q.copy_from_slice(&q0);
             qd.copy_from_slice(&qd0);
-            if self.assemble(mech, ws, t, q, qd, &held).is_ok() {
+            if let Ok(r) = self.assemble(mech, ws, t, q, qd, &held) {
                 assembled.copy_from_slice(qd);
+                report = r;
+                current = true;
             } else {
                 velocities.pop();
+                current = false;
             }
         }
-        // The last trial may have failed: assemble once more with what held, which
-        // leaves its partition current.
-        let held = Prescription {
-            coordinates: prescription.coordinates,
-            velocities: &velocities,
-        };
-        q.copy_from_slice(&q0);
-        qd.copy_from_slice(&qd0);
-        let report = self.assemble(mech, ws, t, q, qd, &held)?;
+        if !current {
+            // The last trial failed: assemble once more with what held, which leaves
+            // its partition current.
+            let held = Prescription {
+                coordinates: prescription.coordinates,
+                velocities: &velocities,
+            };
+            q.copy_from_slice(&q0);
+            qd.copy_from_slice(&qd0);
+            report = self.assemble(mech, ws, t, q, qd, &held)?;
+        }
         let overridden = declared
             .into_iter()
             .filter_map(|d| changed(qd, d))

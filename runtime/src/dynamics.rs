@@ -187,8 +187,12 @@ pub enum DynamicsError {
 pub struct Dynamics {
     params: DynamicsParams,
     info: &'static Info,
+    /// Whether the dense path is taken (below the sparse crossover).
+    dense_path: bool,
     /// The dense path: partial pivoting first, complete pivoting when its pivots
-    /// suggest a singular matrix.
+    /// suggest a singular matrix. Allocated by [`Dynamics::new`] when there is no
+    /// generated solve to try first, else at the first solve that needs them (most
+    /// runs of a model with a generated solve never do: ten allocations fewer per run).
     small: Option<SmallLu>,
     dense: Option<DenseLu>,
     sparse: Option<SparseKkt>,
@@ -339,11 +343,13 @@ impl Dynamics {
         } else {
             None
         };
+        let eager = dense && params.solver != LinearSolver::Auto;
         Ok(Self {
             params,
             info,
-            small: dense.then(|| SmallLu::new(dim)),
-            dense: dense.then(|| DenseLu::new(dim, 1)),
+            dense_path: dense,
+            small: eager.then(|| SmallLu::new(dim)),
+            dense: eager.then(|| DenseLu::new(dim, 1)),
             sparse,
             generated: params.solver == LinearSolver::Auto,
             x: vec![0.0; dim],
@@ -492,6 +498,9 @@ impl Dynamics {
             }
         }
         right_hand_side(ws, shift, &mut self.b);
+        if self.dense_path && self.small.is_none() {
+            self.allocate_dense();
+        }
         let small = self.small.as_mut().and_then(|lu| {
             fill_small(lu, info, ws);
             let ratio = lu.factor().ratio();
@@ -543,6 +552,15 @@ impl Dynamics {
             None => self.solve_redundant(ws, t, velocities)?,
         };
         self.finish(t, out, stats)
+    }
+
+    /// The buffers of the dense path, at its first use.
+    #[cold]
+    #[inline(never)]
+    fn allocate_dense(&mut self) {
+        let dim = self.x.len();
+        self.small = Some(SmallLu::new(dim));
+        self.dense = Some(DenseLu::new(dim, 1));
     }
 
     /// Checks the solution in `x` and hands it out as `out` $= [\ddot q; \lambda]$.

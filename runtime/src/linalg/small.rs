@@ -570,7 +570,16 @@ impl GramPlan {
     pub fn new(rows: &[usize], n: usize, nonzero: impl Fn(usize, usize) -> bool) -> Self {
         let r = rows.len();
         let index = |v: usize| u32::try_from(v).expect("a matrix of fewer than 2^32 entries");
-        let mut products = Vec::new();
+        // Counted first, so that the plan is one allocation of its size.
+        let mut count = 0;
+        for j in 0..n {
+            for (i, &ri) in rows.iter().enumerate() {
+                if nonzero(ri, j) {
+                    count += rows[..=i].iter().filter(|&&rk| nonzero(rk, j)).count();
+                }
+            }
+        }
+        let mut products = Vec::with_capacity(count);
         for j in 0..n {
             for (i, &ri) in rows.iter().enumerate() {
                 if !nonzero(ri, j) {

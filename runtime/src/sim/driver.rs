@@ -156,7 +156,10 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         }
     }
 
-    fn run(&self, stepper: Option<&Stepper>) -> Run {
+    /// The run so far; moves the recorded rows and lists out (the recorder is not
+    /// used after it: a copy of the trajectory was a copy and seven allocations per
+    /// run).
+    fn run(&mut self, stepper: Option<&Stepper>) -> Run {
         let mut stats = Stats {
             newton_iterations: self.sys.point.newton_iterations,
             factorizations: self.sys.point.factorizations,
@@ -175,15 +178,16 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             stats.restarts = o.restarts.saturating_sub(1);
         }
         let (impacts, contact_events) = super::contacts::take(&self.sys);
+        let info = self.sys.point.info;
         Run {
-            trajectory: self.traj.clone(),
+            trajectory: std::mem::replace(&mut self.traj, Trajectory::new(info, 0)),
             stats,
             monitors: self.monitors,
-            redundant_constraints: self.sys.point.redundant.clone(),
-            overridden_velocities: self.overridden.clone(),
+            redundant_constraints: std::mem::take(&mut self.sys.point.redundant),
+            overridden_velocities: std::mem::take(&mut self.overridden),
             impacts,
             contact_events,
-            repartition_times: self.repartition_times.clone(),
+            repartition_times: std::mem::take(&mut self.repartition_times),
         }
     }
 

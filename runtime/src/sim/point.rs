@@ -325,6 +325,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// (allocates).
     pub fn fit_rows(&mut self, holonomic: &[usize]) {
         let (mh, nnh) = (self.info.nh(), self.info.nnh());
+        let same = self.rows_h == holonomic.len()
+            && self.rows[..self.rows_h] == *holonomic
+            && self.rows[self.rows_h..].iter().copied().eq(mh..mh + nnh);
+        if same {
+            // The rows of `Point::new` or of the last fit: the plans hold.
+            self.rank = self.rank.max(self.rows_h);
+            return;
+        }
         self.rows.clear();
         self.rows.extend_from_slice(holonomic);
         self.rows.extend(mh..mh + nnh);
