@@ -531,6 +531,10 @@ fn solve_rows_fixed<const N: usize>(
 /// $A_R$ at a time (a sum of outer products): its `r(r+1)/2` sums are independent, where
 /// dot products of rows are each a chain of `n` dependent additions. The sums run over
 /// the columns in the same order either way, so the two give the same bits.
+///
+/// The dense reference of [`gram_cholesky_planned`], which every Gram matrix of the
+/// runtime uses (its tests compare the two bit for bit).
+#[cfg(test)]
 pub(crate) fn gram_cholesky(ch: &mut SmallCholesky, a: &[f64], rows: &[usize], n: usize) -> f64 {
     let r = rows.len();
     let g = ch.matrix_mut();
@@ -546,7 +550,7 @@ pub(crate) fn gram_cholesky(ch: &mut SmallCholesky, a: &[f64], rows: &[usize], n
     ch.factor().ratio()
 }
 
-/// The products of the Gram matrix $A_R A_R^\mathsf{T}$ of [`gram_cholesky`] that the
+/// The products of the Gram matrix $A_R A_R^\mathsf{T}$ of `gram_cholesky` that the
 /// sparsity of the rows leaves, for [`gram_cholesky_planned`]: the constraint
 /// Jacobians of mechanisms have a few entries per row (andrews' $6 \times 7$ $C_q$ has
 /// 20 of 42), so the rows share few columns and most of the $r(r+1)n/2$ products of
@@ -592,7 +596,7 @@ impl GramPlan {
     }
 }
 
-/// [`gram_cholesky`] with the products of `plan` only: the same matrix to the last
+/// `gram_cholesky` with the products of `plan` only: the same matrix to the last
 /// bit (a skipped product is $\pm 0$, which adds nothing to a sum), so the same
 /// factor and ratio.
 pub(crate) fn gram_cholesky_planned(ch: &mut SmallCholesky, a: &[f64], plan: &GramPlan) -> f64 {
@@ -610,6 +614,7 @@ pub(crate) fn gram_cholesky_planned(ch: &mut SmallCholesky, a: &[f64], plan: &Gr
 }
 
 /// The lower triangle of [`gram_cholesky`]'s matrix for `R` rows.
+#[cfg(test)]
 // Index loops over constant bounds are what the compiler unrolls.
 #[allow(clippy::needless_range_loop)]
 fn gram_fixed<const R: usize>(g: &mut [f64], a: &[f64], rows: &[usize], n: usize) {

@@ -42,7 +42,7 @@
 
 use super::point::{Point, REFIT_RATIO};
 use crate::linalg::inf_norm;
-use crate::linalg::small::{gram_cholesky, SmallCholesky};
+use crate::linalg::small::{gram_cholesky_planned, SmallCholesky};
 use crate::scale;
 use crate::workspace::EvalError;
 use crate::{Info, Mechanism};
@@ -153,14 +153,17 @@ impl Maps {
         }
         self.all_rows = self.rows.len() == self.slot.len()
             && self.rows.iter().enumerate().all(|(k, &i)| k == i);
+        // The Gram matrices from the products the patterns leave (the point's plans are
+        // made for its rows, which the maps copied): the dense sums' bits.
+        let (plan_h, plan_v) = p.gram_plans();
         if m > r {
             gram.resize(m);
-            let ratio = gram_cholesky(gram, &self.normals, &self.rows, n);
+            let ratio = gram_cholesky_planned(gram, &self.normals, plan_v);
             gram.inverse_into(&mut self.velocity_map);
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
         gram.resize(r);
-        let ratio = gram_cholesky(gram, &self.normals, &self.rows[..r], n);
+        let ratio = gram_cholesky_planned(gram, &self.normals, plan_h);
         for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
             out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
         }

@@ -346,6 +346,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
 
     /// The plans of the projections' Gram matrices for the current `rows`, from the
     /// patterns of $C_q$ and $G$ (allocates).
+    /// The plans of the Gram matrices of the rows `rows[..rows_h]` and of all `rows`
+    /// (made with them, see [`fit_rows`](Self::fit_rows)).
+    pub fn gram_plans(&self) -> (&GramPlan, &GramPlan) {
+        (&self.gram_h, &self.gram_v)
+    }
+
     fn plan_grams(&mut self) {
         let info = self.info;
         let (n, mh) = (info.nq(), info.nh());
