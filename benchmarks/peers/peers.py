@@ -507,9 +507,11 @@ def main():
     parser.add_argument("--pfaff", required=True, help="path of the release `pfaff` binary")
     parser.add_argument("--models", default="pendulum,andrews,car_axis")
     parser.add_argument("--tols", default=",".join(f"1e-{k}" for k in range(4, 13)))
-    parser.add_argument("--pfaff-tols", default=",".join(f"1e-{k},3e-{k + 1}" for k in range(2, 13)) + ",1e-13",
-                        help="pfaff is also run at these tolerances (default: half decades from 1e-2 to "
-                             "1e-13), as candidates of the equal-accuracy comparison")  # fmt: skip
+    parser.add_argument("--pfaff-tols",
+                        default=",".join(f"1e-{k},5e-{k + 1},3e-{k + 1},2e-{k + 1}" for k in range(2, 13)) + ",1e-13",
+                        help="pfaff is also run at these tolerances (default: four per decade, 1, 5, 3 and "
+                             "2 times 10^-k, from 1e-2 to 1e-13), as candidates of the equal-accuracy "
+                             "comparison")  # fmt: skip
     parser.add_argument("--repeat", type=int, default=5, help="timed repetitions (best is kept)")
     parser.add_argument("--budget", type=float, default=2.0,
                         help="a run longer than this many seconds is timed once")  # fmt: skip
@@ -574,8 +576,8 @@ def main():
         "pendulum against its closed form, andrews and car_axis against the test-set references), "
         "right-hand-side evaluations and wall time (best of several runs). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
-        "with the fastest pfaff run, any method and tolerance (this table's and those of the half-decade "
-        "table below), that is at least as accurate: whose error, and that of the same pfaff method at every "
+        "with the fastest pfaff run, any method and tolerance (this table's and those of the table "
+        "between the decades below), that is at least as accurate: whose error, and that of the same pfaff method at every "
         "tighter tolerance, is at most the peer's (a loose run that meets the reference by a lucky phase "
         "does not count).",
         *notes,
@@ -585,7 +587,7 @@ def main():
         "(any method, any tolerance) at least as accurate; above 1 pfaff is faster, `—`: no pfaff run as accurate.",
         render_equal(rows, tols),
         "## pfaff between the decades",
-        "pfaff alone at the tolerances of `--pfaff-tols` the peers were not run at (half decades): "
+        "pfaff alone at the tolerances of `--pfaff-tols` the peers were not run at (four per decade): "
         "candidates of the comparison at equal accuracy, so that the pfaff run it picks is not much more "
         "accurate, and slower, than the peer's run only because the decades are far apart.",
         render_extra(rows),

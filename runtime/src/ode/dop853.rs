@@ -14,8 +14,9 @@
 //! and $E_3 = \sum_i (\text{err}^{(3)}_i/s_i)^2$,
 //! $$\text{err} = |h|\,\frac{E_5}{\sqrt{n\,(E_5 + 0.01\,E_3)}},$$
 //! which behaves like $h^8$ for small $h$ and is accepted when $\le 1$. The step size
-//! follows Hairer's controller with $\text{safe} = 0.9$, $\beta = 0$,
-//! $\text{fac}_1 = 0.333$, $\text{fac}_2 = 6$, exponent $1/8$.
+//! follows Gustafsson's PI.3.4 controller with the predictive limit
+//! (`common::PiController::gustafsson` with $q = 8$), $\text{safe} = 0.85$,
+//! $\text{fac}_1 = 0.333$, $\text{fac}_2 = 6$ (Hairer's bounds).
 
 use super::common::{check_state, eval, PiController};
 use super::dop853_tableau::{A, BHH, C, D, ER};
@@ -96,7 +97,7 @@ impl Dop853 {
     /// Invalid options, see [`OdeOptions::validate`].
     pub fn new(dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
         let v = || vec![0.0; dim];
-        let ctrl = PiController::new(1.0 / 8.0, 0.0, 0.9, 0.333, 6.0);
+        let ctrl = PiController::gustafsson(8.0, 0.333, 6.0);
         let m = Dp853 {
             dense_ready: false,
             dense_from: None,

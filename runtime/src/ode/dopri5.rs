@@ -11,9 +11,9 @@
 //!
 //! Error control: the local error estimate $h\sum_i e_i k_i$ of the embedded
 //! fourth-order solution is measured in the mixed RMS norm of [`Tolerances`]
-//! (accepted when $\le 1$); the step size follows Hairer's PI controller with
-//! $\text{safe} = 0.9$, $\beta = 0.04$, $\text{fac}_1 = 0.2$, $\text{fac}_2 = 10$,
-//! exponent $1/5 - 0.75\beta$.
+//! (accepted when $\le 1$); the step size follows Gustafsson's PI.3.4 controller with
+//! the predictive limit (`common::PiController::gustafsson` with $q = 5$), $\text{safe} =
+//! 0.85$, $\text{fac}_1 = 0.2$, $\text{fac}_2 = 10$ (Hairer's bounds).
 //!
 //! [`Tolerances`]: super::Tolerances
 
@@ -86,7 +86,7 @@ impl Dopri5 {
     /// # Errors
     /// Invalid options, see [`OdeOptions::validate`].
     pub fn new(dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
-        let ctrl = PiController::new(0.2 - 0.04 * 0.75, 0.04, 0.9, 0.2, 10.0);
+        let ctrl = PiController::gustafsson(5.0, 0.2, 10.0);
         let m = Dp5 {
             dense_ready: false,
             dense_from: None,
