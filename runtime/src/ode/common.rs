@@ -247,9 +247,39 @@ pub(crate) struct PiController {
     facold: f64,
     /// The exponent $1/q$ of the predictive limit and of the cut after a rejection.
     expo: f64,
+    predictive: Predictive,
+}
+
+/// Gustafsson's predictive limit (Hairer's `radau5.f`): remembers the last accepted step
+/// and its error, and after the next accepted step $h$ with error $\text{err}$ gives the
+/// least divisor of $h$ it allows,
+/// $\frac{h_{\text{acc}}}{h}\big(\text{err}^2/\text{err}_{\text{acc}}\big)^{e}/\text{safe}$
+/// (unclamped): the error's trend over the two steps, extrapolated. Shared by
+/// [`PiController`] and `Radau5`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Predictive {
     /// The last accepted step size (0 before the first) and its error (at least 0.01).
     h_acc: f64,
     err_acc: f64,
+}
+
+impl Predictive {
+    /// Nothing accepted yet (and after a reset).
+    pub(crate) const NEW: Self = Self {
+        h_acc: 0.0,
+        err_acc: ERRACC_MIN,
+    };
+
+    /// After an accepted step of size `h` with error `err`: the limit's divisor with
+    /// exponent `expo` and safety factor `safe` (`None` when no step was accepted
+    /// before); remembers this step.
+    pub(crate) fn accept(&mut self, h: f64, err: f64, expo: f64, safe: f64) -> Option<f64> {
+        let limit = (self.h_acc != 0.0)
+            .then(|| (self.h_acc / h) * (err * err / self.err_acc).powf(expo) / safe);
+        self.h_acc = h;
+        self.err_acc = err.max(ERRACC_MIN);
+        limit
+    }
 }
 
 /// The least error the controllers remember: $\text{err}_{\text{old}}$ of the PI term
@@ -281,16 +311,14 @@ impl PiController {
             facc2: 1.0 / fac2,
             facold: FACOLD_MIN,
             expo,
-            h_acc: 0.0,
-            err_acc: ERRACC_MIN,
+            predictive: Predictive::NEW,
         }
     }
 
     /// Forgets the previous errors and steps (at reset).
     pub(crate) fn reset(&mut self) {
         self.facold = FACOLD_MIN;
-        self.h_acc = 0.0;
-        self.err_acc = ERRACC_MIN;
+        self.predictive = Predictive::NEW;
     }
 
     /// The next step size after an attempt of size `h` with error `err` (a NaN or an
@@ -301,12 +329,9 @@ impl PiController {
             let pi = err.powf(self.expo1) / self.facold.powf(self.beta) / self.safe;
             let mut fac = pi.min(self.facc1).max(self.facc2);
             self.facold = err.max(FACOLD_MIN);
-            if self.h_acc != 0.0 {
-                let gus = (self.h_acc / h) * (err * err / self.err_acc).powf(self.expo) / self.safe;
+            if let Some(gus) = self.predictive.accept(h, err, self.expo, self.safe) {
                 fac = fac.max(gus.min(self.facc1).max(self.facc2));
             }
-            self.h_acc = h;
-            self.err_acc = err.max(ERRACC_MIN);
             (h / fac, true)
         } else {
             (h / self.facc1.min(err.powf(self.expo) / self.safe), false)

@@ -35,7 +35,7 @@
 
 use super::common::{
     check_len, check_state, check_stop, eval, hinit, interpolate_prelude, is_recoverable,
-    limit_to_stop, replace_state, underflows, RECOVER_FACTOR, UROUND,
+    limit_to_stop, replace_state, underflows, Predictive, RECOVER_FACTOR, UROUND,
 };
 use super::error::{OdeError, Quantity};
 use super::integrator::Integrator;
@@ -179,12 +179,12 @@ pub struct Radau5 {
     h_fact: f64,
     theta: f64,
     faccon: f64,
-    h_acc: f64,
+    /// Gustafsson's predictive limit on the accepted steps.
+    predictive: Predictive,
     /// Largest step size the stage iteration is trusted with: set to the reduced step
     /// after the iteration fails to converge, relaxed by [`NEWTON_CAP_GROWTH`] per
     /// accepted step.
     newton_cap: f64,
-    err_acc: f64,
     y: Vec<f64>,
     f0: Vec<f64>,
     scal: Vec<f64>,
@@ -251,9 +251,8 @@ impl Radau5 {
             h_fact: 0.0,
             theta: 0.0,
             faccon: 1.0,
-            h_acc: 0.0,
+            predictive: Predictive::NEW,
             newton_cap: f64::INFINITY,
-            err_acc: 1e-2,
             y: v(),
             f0: v(),
             scal: v(),
@@ -576,8 +575,7 @@ impl Integrator for Radau5 {
         self.h_fact = 0.0;
         self.faccon = 1.0;
         self.theta = 0.0;
-        self.err_acc = 1e-2;
-        self.h_acc = 0.0;
+        self.predictive = Predictive::NEW;
         self.newton_cap = f64::INFINITY;
         self.dir = h0.map_or(1.0, f64::signum);
         self.update_scal();
@@ -686,13 +684,11 @@ impl Integrator for Radau5 {
                 continue;
             }
             // Accepted: Gustafsson's predictive controller.
-            if !self.first && self.h_acc != 0.0 {
-                let facgus = (self.h_acc / h) * (err * err / self.err_acc).powf(0.25) / SAFE;
+            let limit = self.predictive.accept(h, err, 0.25, SAFE);
+            if let (false, Some(facgus)) = (self.first, limit) {
                 quot = quot.max(facgus.clamp(FACR, FACL));
                 h_new = h / quot;
             }
-            self.h_acc = h;
-            self.err_acc = err.max(1e-2);
             let t_new = match (hits, t_stop) {
                 (true, Some(ts)) => ts,
                 _ => self.t + h,
