@@ -436,6 +436,13 @@ impl Dynamics {
         stats
     }
 
+    /// Whether the model's generated solve of the augmented system is tried first and
+    /// no split of redundant rows is in use: the state in which
+    /// [`Mechanism::augmented_solve`] answers for this model.
+    pub(crate) fn generated_solve(&self) -> bool {
+        self.generated && self.split.is_none()
+    }
+
     /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
     /// $\gamma$ already evaluated in `ws` (lengths checked by the caller), into
     /// `out` $= [\ddot q; \lambda]$ (length $n + m$; its contents are unspecified
