@@ -205,6 +205,13 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
     /// dynamics terms only where it is read").
     pub constraints_with_terms: bool,
+    /// Whether the dynamics terms held (stamp `terms`) passed their finiteness check:
+    /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
+    /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
+    terms_checked: bool,
+    /// Whether the last solve of [`accelerations`](Self::accelerations) took a path
+    /// other than the generated one: the next checks its terms before solving.
+    declined: bool,
     /// $[\Delta q; \mu]$ of [`project_in_mass_metric`](Self::project_in_mass_metric).
     solution_scratch: Vec<f64>,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
@@ -263,6 +270,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             factorizations: 0,
             redundant: Vec::new(),
             constraints_with_terms: false,
+            terms_checked: true,
+            declined: false,
             solution_scratch: vec![0.0; n + m],
             rank: 0,
         };
@@ -586,6 +595,24 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
+        // The terms just evaluated go to the generated solve unchecked: it declines, or
+        // leaves a non-finite entry in its solution, whenever one of them is not finite
+        // (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`), so
+        // a finite solution proves them finite. Otherwise they are checked first (which
+        // names a non-finite one), then solved by the general path.
+        if !self.terms_checked && !redundant && !self.declined && self.dynamics.generated_solve() {
+            if self
+                .dynamics
+                .try_generated(self.mech, &self.ws, shift, &mut self.solution)
+                .is_some()
+            {
+                self.terms_checked = true;
+                self.solved = state;
+                return Ok(());
+            }
+            self.declined = true;
+        }
+        self.check_terms(t)?;
         if redundant {
             self.redundant_velocity_residuals(t)?;
         }
@@ -605,6 +632,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 &mut self.solution,
             )
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
+        // The generated solve serves again: the next terms may skip their check.
+        self.declined = stats.path != SolverPath::Generated;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
             self.dense = position;
@@ -632,7 +661,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// and $C$ when [`constraints_with_terms`](Self::constraints_with_terms)).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
-        self.dynamics_terms_at(t, versions, self.constraints_with_terms)
+        self.dynamics_terms_at(t, versions, self.constraints_with_terms)?;
+        self.check_terms(t)
     }
 
     /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
@@ -642,6 +672,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
         self.dynamics_terms_at(t, versions, true)?;
+        self.check_terms(t)?;
         if self.constraints != versions.0 {
             self.constraints(t).map_err(SimErrorKind::from_eval)?;
         }
@@ -666,13 +697,34 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 self.constraints = 0;
             }
             self.ws
-                .eval_dynamics_terms_held(self.mech, t, &self.q, &self.qd, with_c)
-                .map_err(SimErrorKind::from_eval)?;
+                .eval_dynamics_terms_unchecked(self.mech, t, &self.q, &self.qd, with_c);
+            self.terms_checked = false;
             self.terms = state;
             self.jacobian = position;
             if with_c {
                 self.stamp_terms_constraints(position);
             }
+        }
+        Ok(())
+    }
+
+    /// The finiteness check of the held dynamics terms ([`Workspace::check_dynamics_terms`],
+    /// naming the first non-finite entry), once per evaluation; terms that fail it are
+    /// forgotten with what was stamped from them.
+    fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if !self.terms_checked {
+            if let Err(e) = self.ws.check_dynamics_terms(t) {
+                for s in [
+                    &mut self.terms,
+                    &mut self.jacobian,
+                    &mut self.dense,
+                    &mut self.solved,
+                ] {
+                    *s = 0;
+                }
+                return Err(SimErrorKind::from_eval(e));
+            }
+            self.terms_checked = true;
         }
         Ok(())
     }
@@ -719,6 +771,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // The velocities may have changed: a new state version, the same position.
         let (position, state) = self.versions(t);
         self.terms = state;
+        self.terms_checked = true;
         self.jacobian = position;
         if with_c {
             self.stamp_terms_constraints(position);
