@@ -436,6 +436,40 @@ impl Dynamics {
         stats
     }
 
+    /// The model's generated solve of (E31) with the evaluated terms of `ws` (and the
+    /// shift of $\gamma$) into `out`: `None` when it declines, has no generated solve
+    /// (then not tried again) or leaves a non-finite entry, for the general path.
+    #[inline]
+    pub(crate) fn try_generated<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        ws: &Workspace,
+        shift: Option<&[f64]>,
+        out: &mut [f64],
+    ) -> Option<AccelerationStats> {
+        right_hand_side(ws, shift, out);
+        match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, out) {
+            // A non-finite result goes to the general path, which reports it.
+            AugmentedSolve::Solved if all_finite(out) => Some(AccelerationStats {
+                path: SolverPath::Generated,
+                rank: self.info.nh() + self.info.nnh(),
+                pivot_ratio: 1.0,
+            }),
+            AugmentedSolve::Unavailable => {
+                self.generated = false;
+                None
+            }
+            AugmentedSolve::Solved | AugmentedSolve::Declined => None,
+        }
+    }
+
+    /// Whether the model's generated solve of the augmented system is tried first and
+    /// no split of redundant rows is in use: the state in which
+    /// [`Mechanism::augmented_solve`] answers for this model.
+    pub(crate) fn generated_solve(&self) -> bool {
+        self.generated && self.split.is_none()
+    }
+
     /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
     /// $\gamma$ already evaluated in `ws` (lengths checked by the caller), into
     /// `out` $= [\ddot q; \lambda]$ (length $n + m$; its contents are unspecified
@@ -483,18 +517,8 @@ impl Dynamics {
         }
 
         if self.generated {
-            right_hand_side(ws, shift, out);
-            match mech.augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, out) {
-                // A non-finite result goes to the general path, which reports it.
-                AugmentedSolve::Solved if all_finite(out) => {
-                    return Ok(AccelerationStats {
-                        path: SolverPath::Generated,
-                        rank: m,
-                        pivot_ratio: 1.0,
-                    });
-                }
-                AugmentedSolve::Unavailable => self.generated = false,
-                AugmentedSolve::Solved | AugmentedSolve::Declined => {}
+            if let Some(stats) = self.try_generated(mech, ws, shift, out) {
+                return Ok(stats);
             }
         }
         right_hand_side(ws, shift, &mut self.b);

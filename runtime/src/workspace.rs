@@ -630,10 +630,28 @@ impl Workspace {
         qd: &[f64],
         constraints: bool,
     ) -> Result<(), EvalError> {
+        self.eval_dynamics_terms_unchecked(mech, t, q, qd, constraints);
+        self.check_dynamics_terms(t)
+    }
+
+    /// [`eval_dynamics_terms_held`](Self::eval_dynamics_terms_held) without the check of
+    /// the terms, for a caller that checks them with
+    /// [`check_dynamics_terms`](Self::check_dynamics_terms) before anything but the
+    /// model's generated solve reads them (which declines, or leaves a non-finite
+    /// entry in its solution, whenever an input is not finite: see
+    /// `sim::point::Point::accelerations`).
+    #[inline]
+    pub(crate) fn eval_dynamics_terms_unchecked<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        constraints: bool,
+    ) {
         debug_assert!(self.check_model(mech, q, Some(qd)).is_ok());
         let (terms, _) = self.dynamics_outputs(constraints);
         mech.dynamics_terms(t, q, qd, terms);
-        self.check_dynamics_terms(t)
     }
 
     /// [`eval_dynamics_terms`](Self::eval_dynamics_terms) through
@@ -667,7 +685,7 @@ impl Workspace {
     /// makes its lane, and so the sum, NaN or infinite for good; finite entries whose
     /// sum overflows only cost the scan, which then finds nothing.
     #[inline]
-    fn check_dynamics_terms(&self, t: f64) -> Result<(), EvalError> {
+    pub(crate) fn check_dynamics_terms(&self, t: f64) -> Result<(), EvalError> {
         let mut acc = [0.0; 4];
         for x in [
             &self.mass_values,

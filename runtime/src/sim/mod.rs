@@ -33,12 +33,18 @@
 //!   The choice of this chart over a partition of the coordinates themselves, with the
 //!   measurements behind it, is explained in `ARCHITECTURE.md`.
 //! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
-//!   step $q$ is projected onto $C(q,t) = 0$ by Newton with minimum-norm corrections
-//!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and $\dot q$ onto
-//!   $J\dot q + [C_t; g] = 0$ by
-//!   $\dot q \leftarrow \dot q - J^\mathsf{T}(JJ^\mathsf{T})^{-1}(J\dot q + [C_t; g])$,
+//!   step $q$ is projected onto $C(q,t) = 0$ and $\dot q$ onto $J\dot q + [C_t; g] = 0$,
 //!   handed back with [`Integrator::set_state`](crate::ode::Integrator::set_state).
-//!   The projections are dense in $m$.
+//!   Where the model's generated solve of (E31) serves, in the metric of $M$ (the
+//!   solve with right-hand sides $[0; -C; 0]$ and $[0; -(J\dot q + [C_t; g])]$: Newton
+//!   updates $\Delta q = -M^{-1}J^\mathsf{T}(JM^{-1}J^\mathsf{T})^{-1}[C; 0]$, then the
+//!   velocity change of least kinetic energy); otherwise (no generated solve,
+//!   redundant rows) orthogonally, by Newton with minimum-norm corrections
+//!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and
+//!   $\dot q \leftarrow \dot q - J^\mathsf{T}(JJ^\mathsf{T})^{-1}(J\dot q + [C_t; g])$,
+//!   dense in $m$. Either meets $C$ to the Newton tolerance and the velocity
+//!   constraints to round-off (`ARCHITECTURE.md`, "Decision: the projection in the
+//!   metric of the mass matrix").
 //! - [`Formulation::Baumgarte`]: index 1 on $y = [q; \dot q]$ with
 //!   $\gamma_h \leftarrow \gamma_h - 2\alpha(C_q\dot q + C_t) - \beta^2 C$ and
 //!   $\gamma_{nh} \leftarrow \gamma_{nh} - 2\alpha(G\dot q + g)$, so that the

@@ -15,6 +15,8 @@
 //! many groups are evaluated at it.
 //! Nothing allocates after [`Point::new`] (except when building an error).
 
+use std::cmp::Ordering;
+
 use super::error::{SimErrorKind, SingularMatrix};
 use crate::dynamics::{Dynamics, DynamicsParams, SolverPath, Velocities};
 use crate::kinematics::{Kinematics, KinematicsParams};
@@ -203,6 +205,15 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
     /// dynamics terms only where it is read").
     pub constraints_with_terms: bool,
+    /// Whether the dynamics terms held (stamp `terms`) passed their finiteness check:
+    /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
+    /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
+    terms_checked: bool,
+    /// Whether the last solve of [`accelerations`](Self::accelerations) took a path
+    /// other than the generated one: the next checks its terms before solving.
+    declined: bool,
+    /// $[\Delta q; \mu]$ of [`project_in_mass_metric`](Self::project_in_mass_metric).
+    solution_scratch: Vec<f64>,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
     /// in one fused call (read by the tests).
     #[cfg_attr(not(test), allow(dead_code))]
@@ -259,6 +270,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             factorizations: 0,
             redundant: Vec::new(),
             constraints_with_terms: false,
+            terms_checked: true,
+            declined: false,
+            solution_scratch: vec![0.0; n + m],
             rank: 0,
         };
         point.plan_grams();
@@ -581,6 +595,24 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
+        // The terms just evaluated go to the generated solve unchecked: it declines, or
+        // leaves a non-finite entry in its solution, whenever one of them is not finite
+        // (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`), so
+        // a finite solution proves them finite. Otherwise they are checked first (which
+        // names a non-finite one), then solved by the general path.
+        if !self.terms_checked && !redundant && !self.declined && self.dynamics.generated_solve() {
+            if self
+                .dynamics
+                .try_generated(self.mech, &self.ws, shift, &mut self.solution)
+                .is_some()
+            {
+                self.terms_checked = true;
+                self.solved = state;
+                return Ok(());
+            }
+            self.declined = true;
+        }
+        self.check_terms(t)?;
         if redundant {
             self.redundant_velocity_residuals(t)?;
         }
@@ -600,6 +632,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 &mut self.solution,
             )
             .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
+        // The generated solve serves again: the next terms may skip their check.
+        self.declined = stats.path != SolverPath::Generated;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
             self.dense = position;
@@ -627,7 +661,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// and $C$ when [`constraints_with_terms`](Self::constraints_with_terms)).
     pub fn dynamics_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
-        self.dynamics_terms_at(t, versions, self.constraints_with_terms)
+        self.dynamics_terms_at(t, versions, self.constraints_with_terms)?;
+        self.check_terms(t)
     }
 
     /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
@@ -637,6 +672,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
         self.dynamics_terms_at(t, versions, true)?;
+        self.check_terms(t)?;
         if self.constraints != versions.0 {
             self.constraints(t).map_err(SimErrorKind::from_eval)?;
         }
@@ -661,13 +697,34 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 self.constraints = 0;
             }
             self.ws
-                .eval_dynamics_terms_held(self.mech, t, &self.q, &self.qd, with_c)
-                .map_err(SimErrorKind::from_eval)?;
+                .eval_dynamics_terms_unchecked(self.mech, t, &self.q, &self.qd, with_c);
+            self.terms_checked = false;
             self.terms = state;
             self.jacobian = position;
             if with_c {
                 self.stamp_terms_constraints(position);
             }
+        }
+        Ok(())
+    }
+
+    /// The finiteness check of the held dynamics terms ([`Workspace::check_dynamics_terms`],
+    /// naming the first non-finite entry), once per evaluation; terms that fail it are
+    /// forgotten with what was stamped from them.
+    fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if !self.terms_checked {
+            if let Err(e) = self.ws.check_dynamics_terms(t) {
+                for s in [
+                    &mut self.terms,
+                    &mut self.jacobian,
+                    &mut self.dense,
+                    &mut self.solved,
+                ] {
+                    *s = 0;
+                }
+                return Err(SimErrorKind::from_eval(e));
+            }
+            self.terms_checked = true;
         }
         Ok(())
     }
@@ -714,6 +771,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // The velocities may have changed: a new state version, the same position.
         let (position, state) = self.versions(t);
         self.terms = state;
+        self.terms_checked = true;
         self.jacobian = position;
         if with_c {
             self.stamp_terms_constraints(position);
@@ -777,10 +835,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// Projection onto the constraint manifold: Newton with minimum-norm corrections
-    /// $\Delta q = -C_q^\mathsf{T}(C_q C_q^\mathsf{T})^{-1}C$ on the positions until
-    /// $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$, then
-    /// [`project_velocities`](Self::project_velocities).
+    /// Projection onto the constraint manifold, in the metric of the mass matrix where
+    /// the model's generated solve of the augmented system serves
+    /// ([`project_in_mass_metric`](Self::project_in_mass_metric)), else (no generated
+    /// solve, redundant rows, no convergence) orthogonally: Newton with minimum-norm
+    /// corrections $\Delta q = -C_q^\mathsf{T}(C_q C_q^\mathsf{T})^{-1}C$ on the
+    /// positions until $\lVert C\rVert_\infty \le \varepsilon(1 + \lVert q\rVert_\infty)$,
+    /// then [`project_velocities`](Self::project_velocities).
     ///
     /// When the positions took a Newton update and every projected row is holonomic,
     /// the velocities are projected by the chord iteration with the factor of the last
@@ -788,11 +849,106 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// converges to the same orthogonal projection at the corrected positions: one
     /// Gram matrix per projection.
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
+        if self.project_in_mass_metric(t)? {
+            return Ok(());
+        }
         self.project_positions(t)?;
         if self.position_factor && self.chord_velocities(t)? {
             return Ok(());
         }
         self.project_velocities(t)
+    }
+
+    /// Most position updates of [`project_in_mass_metric`](Self::project_in_mass_metric).
+    const MASS_UPDATES: usize = 3;
+
+    /// The projection in the metric of $M$, by the model's generated solve of the
+    /// augmented system (E31) with the right-hand sides $[0; -C; 0]$ and
+    /// $[0; -(J\dot q + [C_t; g])]$: positions by the Newton updates
+    /// $\Delta q = -M^{-1}J^\mathsf{T}(J M^{-1} J^\mathsf{T})^{-1}[C; 0]$ with $M$ of the
+    /// state to project (the integrator's last evaluation, so no evaluation of its
+    /// own) and $J$ at the latest positions (the non-holonomic rows ask $G\Delta q = 0$:
+    /// the correction is one the velocity constraints admit), until the constraints
+    /// are met to the Newton tolerance; then the velocities by one update with $J$ at
+    /// the corrected positions, which meets $J\dot q + [C_t; g] = 0$ to round-off. The
+    /// velocity update is the change of least kinetic energy that meets the velocity
+    /// constraints. `false` when it does not apply (no generated solve, rows dropped
+    /// as redundant, a declined or non-finite solve) or the positions do not converge
+    /// in [`MASS_UPDATES`](Self::MASS_UPDATES) updates, for the orthogonal projection
+    /// to finish from where it stopped.
+    fn project_in_mass_metric(&mut self, t: f64) -> Result<bool, SimErrorKind> {
+        let info = self.info;
+        let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
+        if m == 0 || self.rows.len() != m || self.rows_h != mh || !self.dynamics.generated_solve() {
+            return Ok(false);
+        }
+        let eval = SimErrorKind::from_eval;
+        // M (and J) of the kept state: normally the integrator's last evaluation.
+        self.dynamics_terms(t)?;
+        let tol = self.newton.tolerance;
+        let mut previous = f64::INFINITY;
+        let mut met = false;
+        for update in 0..=Self::MASS_UPDATES {
+            self.constraints_with_jacobian(t).map_err(eval)?;
+            let (c, jac) = (self.ws.constraints(), self.ws.jacobian());
+            let residual = inf_norm(c);
+            let size = scale::coordinate_size(&self.q);
+            if scale::all_met(c, jac, n, tol, size)
+                || (residual >= 0.5 * previous && scale::at_rounding_floor(c, jac, n, size))
+            {
+                met = true;
+                break;
+            }
+            // Not falling (or NaN): the orthogonal projection takes over.
+            if update == Self::MASS_UPDATES
+                || residual.partial_cmp(&previous) != Some(Ordering::Less)
+            {
+                break;
+            }
+            previous = residual;
+            let x = &mut self.solution_scratch;
+            x[..n].fill(0.0);
+            for (xi, ci) in x[n..n + mh].iter_mut().zip(c) {
+                *xi = -ci;
+            }
+            x[n + mh..].fill(0.0);
+            let ws = &self.ws;
+            match self
+                .mech
+                .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x)
+            {
+                crate::AugmentedSolve::Solved if all_finite(x) => {}
+                _ => return Ok(false),
+            }
+            for (qj, d) in self.q.iter_mut().zip(&x[..n]) {
+                *qj += d;
+            }
+            self.newton_iterations += 1;
+            self.factorizations += 1;
+        }
+        if !met {
+            return Ok(false);
+        }
+        // Velocities: one update with J at the corrected positions is exact.
+        self.velocity_residuals(t).map_err(eval)?;
+        let x = &mut self.solution_scratch;
+        x[..n].fill(0.0);
+        for (xi, r) in x[n..].iter_mut().zip(&self.vel) {
+            *xi = -r;
+        }
+        let ws = &self.ws;
+        match self
+            .mech
+            .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x)
+        {
+            crate::AugmentedSolve::Solved if all_finite(x) => {}
+            _ => return Ok(false),
+        }
+        self.factorizations += 1;
+        for (v, d) in self.qd.iter_mut().zip(&x[..n]) {
+            *v += d;
+        }
+        Ok(true)
     }
 
     /// Most updates of [`chord_velocities`](Self::chord_velocities).

@@ -254,6 +254,19 @@ impl<'a, M: Mechanism + ?Sized> StateSpace<'a, M> {
         sys.accept(t)
     }
 
+    /// Corrects the state `y` $= [q; \dot q]$ at `t` as the formulation corrects an
+    /// accepted step (projection: onto $C = 0$ and $J\dot q + [C_t; g] = 0$;
+    /// partitioning: the chart's polish; Baumgarte: nothing) and takes it as the last
+    /// accepted state; read the result with [`q`](Self::q) and [`qd`](Self::qd).
+    ///
+    /// # Errors
+    /// The correction's failures: a Newton iteration that does not converge, a
+    /// singular Gram matrix, a model function that fails.
+    pub fn keep(&mut self, t: f64, y: &[f64]) -> Result<(), SimErrorKind> {
+        self.0.keep(t, y)?;
+        self.0.accept(t)
+    }
+
     /// The full coordinates of the last evaluation.
     #[must_use]
     pub fn q(&self) -> &[f64] {

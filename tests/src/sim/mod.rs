@@ -12,6 +12,7 @@ mod faults;
 mod models;
 mod partitioning;
 mod pendulum;
+mod projection;
 mod proportionality;
 mod redundant;
 mod robustness;
