@@ -209,9 +209,6 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
     /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
     terms_checked: bool,
-    /// Whether the last solve of [`accelerations`](Self::accelerations) took a path
-    /// other than the generated one: the next checks its terms before solving.
-    declined: bool,
     /// $[\Delta q; \mu]$ of [`project_in_mass_metric`](Self::project_in_mass_metric).
     solution_scratch: Vec<f64>,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
@@ -271,7 +268,6 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             redundant: Vec::new(),
             constraints_with_terms: false,
             terms_checked: true,
-            declined: false,
             solution_scratch: vec![0.0; n + m],
             rank: 0,
         };
@@ -595,24 +591,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
-        // The terms just evaluated go to the generated solve unchecked: it declines, or
-        // leaves a non-finite entry in its solution, whenever one of them is not finite
-        // (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`), so
-        // a finite solution proves them finite. Otherwise they are checked first (which
-        // names a non-finite one), then solved by the general path.
-        if !self.terms_checked && !redundant && !self.declined && self.dynamics.generated_solve() {
-            if self
-                .dynamics
-                .try_generated(self.mech, &self.ws, shift, &mut self.solution)
-                .is_some()
-            {
-                self.terms_checked = true;
-                self.solved = state;
-                return Ok(());
-            }
-            self.declined = true;
-        }
-        self.check_terms(t)?;
+        // Terms just evaluated go to the solve unchecked: the generated solve declines,
+        // or leaves a non-finite entry in its solution, whenever one of them is not
+        // finite (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`),
+        // so a finite solution proves them finite; before any other path the solve
+        // checks them, naming a non-finite one.
+        let checked = self.terms_checked;
         if redundant {
             self.redundant_velocity_residuals(t)?;
         }
@@ -621,19 +605,25 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             qd: &self.qd,
             speed: inf_norm(&self.qd),
         });
-        let stats = self
-            .dynamics
-            .solve_evaluated(
-                self.mech,
-                &mut self.ws,
-                t,
-                shift,
-                velocities,
-                &mut self.solution,
-            )
-            .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
-        // The generated solve serves again: the next terms may skip their check.
-        self.declined = stats.path != SolverPath::Generated;
+        let stats = self.dynamics.solve_evaluated(
+            self.mech,
+            &mut self.ws,
+            t,
+            shift,
+            velocities,
+            checked,
+            &mut self.solution,
+        );
+        let stats = match stats {
+            Ok(stats) => stats,
+            Err(e) => {
+                if !checked {
+                    self.forget_terms();
+                }
+                return Err(SimErrorKind::from_analysis(e.into(), Vec::new()));
+            }
+        };
+        self.terms_checked = true;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
             self.dense = position;
@@ -714,19 +704,25 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms_checked {
             if let Err(e) = self.ws.check_dynamics_terms(t) {
-                for s in [
-                    &mut self.terms,
-                    &mut self.jacobian,
-                    &mut self.dense,
-                    &mut self.solved,
-                ] {
-                    *s = 0;
-                }
+                self.forget_terms();
                 return Err(SimErrorKind::from_eval(e));
             }
             self.terms_checked = true;
         }
         Ok(())
+    }
+
+    /// Forgets the dynamics terms and what was stamped from them (after they failed
+    /// their check).
+    fn forget_terms(&mut self) {
+        for s in [
+            &mut self.terms,
+            &mut self.jacobian,
+            &mut self.dense,
+            &mut self.solved,
+        ] {
+            *s = 0;
+        }
     }
 
     /// Stamps the $C$ the dynamics terms wrote, when it is finite (a non-finite one is
