@@ -862,8 +862,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// augmented system (E31) with the right-hand sides $[0; -C; 0]$ and
     /// $[0; -(J\dot q + [C_t; g])]$: positions by the Newton updates
     /// $\Delta q = -M^{-1}J^\mathsf{T}(J M^{-1} J^\mathsf{T})^{-1}[C; 0]$ with $M$ of the
-    /// state to project (the integrator's last evaluation, so no evaluation of its
-    /// own) and $J$ at the latest positions (the non-holonomic rows ask $G\Delta q = 0$:
+    /// integrator's last evaluation (the state to project for DOP853, DOPRI5 and
+    /// Adams, a stage of the step otherwise: no evaluation of its own) and $J$ at the
+    /// latest positions (the non-holonomic rows ask $G\Delta q = 0$:
     /// the correction is one the velocity constraints admit), until the constraints
     /// are met to the Newton tolerance; then the velocities by one update with $J$ at
     /// the corrected positions, which meets $J\dot q + [C_t; g] = 0$ to round-off. The
@@ -879,8 +880,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             return Ok(false);
         }
         let eval = SimErrorKind::from_eval;
-        // M (and J) of the kept state: normally the integrator's last evaluation.
-        self.dynamics_terms(t)?;
+        // M of the integrator's last evaluation: at the kept state for DOP853, DOPRI5
+        // and Adams, at a stage of the step for the others (a metric as good, and no
+        // evaluation of its own); the terms at the kept state when none is held.
+        if self.terms == 0 {
+            self.dynamics_terms(t)?;
+        } else {
+            self.check_terms(t)?;
+        }
         let tol = self.newton.tolerance;
         let mut previous = f64::INFINITY;
         let mut met = false;
@@ -895,13 +902,17 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 met = true;
                 break;
             }
-            // Not falling (or NaN): the orthogonal projection takes over.
-            if update == Self::MASS_UPDATES
-                || residual.partial_cmp(&previous) != Some(Ordering::Less)
-            {
+            // Not falling (or NaN): the orthogonal projection takes over, from the
+            // better of the last two iterates.
+            let falling = residual.partial_cmp(&previous) == Some(Ordering::Less);
+            if !falling && update > 0 {
+                self.q.copy_from_slice(&self.dx);
+            }
+            if update == Self::MASS_UPDATES || !falling {
                 break;
             }
             previous = residual;
+            self.dx.copy_from_slice(&self.q);
             let rows = &mut self.solution_scratch[n..];
             rows[..mh].copy_from_slice(c);
             rows[mh..].fill(0.0);
@@ -913,7 +924,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if !met {
             return Ok(false);
         }
-        // Velocities: one update with J at the corrected positions is exact.
+        // Velocities: one update with J at the corrected positions is exact but for the
+        // rounding of the solve (pivots at least 1e-8 of their diagonals). It is not
+        // checked here: a check cost 4–8 % of a run and never fired (ARCHITECTURE.md),
+        // and the monitors evaluate the velocity residuals at every kept state anyway
+        // (`Run::monitors`, the largest velocity violation).
         self.velocity_residuals(t).map_err(eval)?;
         self.solution_scratch[n..].copy_from_slice(&self.vel);
         Ok(self.mass_metric_update(false))
