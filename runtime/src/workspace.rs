@@ -614,28 +614,15 @@ impl Workspace {
         constraints: bool,
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
-        self.eval_dynamics_terms_held(mech, t, q, qd, constraints)
-    }
-
-    /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with) for a caller that
-    /// holds the model this workspace was made for and coordinates of its length (the
-    /// simulation's point, which builds both from the model once): without the check of
-    /// the model, a call through `dyn Mechanism` and three comparisons per evaluation.
-    #[inline]
-    pub(crate) fn eval_dynamics_terms_held<M: Mechanism + ?Sized>(
-        &mut self,
-        mech: &M,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        constraints: bool,
-    ) -> Result<(), EvalError> {
         self.eval_dynamics_terms_unchecked(mech, t, q, qd, constraints);
         self.check_dynamics_terms(t)
     }
 
-    /// [`eval_dynamics_terms_held`](Self::eval_dynamics_terms_held) without the check of
-    /// the terms, for a caller that checks them with
+    /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with) for a caller that
+    /// holds the model this workspace was made for and coordinates of its length (the
+    /// simulation's point, which builds both from the model once: no check of the
+    /// model, a call through `dyn Mechanism` and three comparisons per evaluation), and
+    /// without the check of the terms, for a caller that checks them with
     /// [`check_dynamics_terms`](Self::check_dynamics_terms) before anything but the
     /// model's generated solve reads them (which declines, or leaves a non-finite
     /// entry in its solution, whenever an input is not finite: see

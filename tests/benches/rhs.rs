@@ -28,8 +28,9 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pfaff::ode::OdeSystem;
-use pfaff::sim::{Formulation, Method, Simulation, StateSpace};
+use pfaff::sim::{Formulation, StateSpace};
 use pfaff::{AugmentedSolve, DynamicsTerms, LinearSolver, Mechanism, DEFAULT_CROSSOVER};
+use pfaff_tests::states::moving_state;
 
 /// A model, and the time after which its state is moving (taken by a tight run from
 /// its initial state) and its motion's time scale.
@@ -61,18 +62,6 @@ const CASES: &[Case] = &[
         0.01,
     ),
 ];
-
-/// The consistent state at `t` from the model's initial state.
-fn moving_state(model: &dyn Mechanism, t: f64) -> (Vec<f64>, Vec<f64>) {
-    let run = Simulation::new(model)
-        .integrator(Method::Dop853)
-        .tolerances(1e-12, 1e-14)
-        .output_times(&[])
-        .run(t)
-        .expect("the reference run");
-    let (_, q, qd) = run.final_state().expect("a final row");
-    (q.to_vec(), qd.to_vec())
-}
 
 fn generated(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) {
     let info = model.info();

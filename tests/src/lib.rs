@@ -3,6 +3,7 @@
 //! One test binary: this library, compiled with `cfg(test)`, holds every module.
 
 pub mod sources;
+pub mod states;
 
 #[cfg(test)]
 mod accuracy;

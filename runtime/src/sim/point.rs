@@ -906,49 +906,49 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 break;
             }
             previous = residual;
-            let x = &mut self.solution_scratch;
-            x[..n].fill(0.0);
-            for (xi, ci) in x[n..n + mh].iter_mut().zip(c) {
-                *xi = -ci;
-            }
-            x[n + mh..].fill(0.0);
-            let ws = &self.ws;
-            match self
-                .mech
-                .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x)
-            {
-                crate::AugmentedSolve::Solved if all_finite(x) => {}
-                _ => return Ok(false),
-            }
-            for (qj, d) in self.q.iter_mut().zip(&x[..n]) {
-                *qj += d;
+            let rows = &mut self.solution_scratch[n..];
+            rows[..mh].copy_from_slice(c);
+            rows[mh..].fill(0.0);
+            if !self.mass_metric_update(true) {
+                return Ok(false);
             }
             self.newton_iterations += 1;
-            self.factorizations += 1;
         }
         if !met {
             return Ok(false);
         }
         // Velocities: one update with J at the corrected positions is exact.
         self.velocity_residuals(t).map_err(eval)?;
+        self.solution_scratch[n..].copy_from_slice(&self.vel);
+        Ok(self.mass_metric_update(false))
+    }
+
+    /// One update of [`project_in_mass_metric`](Self::project_in_mass_metric): with the
+    /// constraint residuals $r$ in the rows of `solution_scratch`, the generated solve
+    /// of $[M\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; -r]$ (the terms held in the
+    /// workspace), and $\Delta$ added to the positions (`positions`) or to the
+    /// velocities. `false`, with nothing changed, when the solve declines or its
+    /// result is not finite.
+    fn mass_metric_update(&mut self, positions: bool) -> bool {
+        let n = self.info.nq();
         let x = &mut self.solution_scratch;
         x[..n].fill(0.0);
-        for (xi, r) in x[n..].iter_mut().zip(&self.vel) {
-            *xi = -r;
+        for r in &mut x[n..] {
+            *r = -*r;
         }
         let ws = &self.ws;
-        match self
+        let solved = self
             .mech
-            .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x)
-        {
-            crate::AugmentedSolve::Solved if all_finite(x) => {}
-            _ => return Ok(false),
+            .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x);
+        if solved != crate::AugmentedSolve::Solved || !all_finite(x) {
+            return false;
         }
         self.factorizations += 1;
-        for (v, d) in self.qd.iter_mut().zip(&x[..n]) {
+        let target = if positions { &mut self.q } else { &mut self.qd };
+        for (v, d) in target.iter_mut().zip(&x[..n]) {
             *v += d;
         }
-        Ok(true)
+        true
     }
 
     /// Most updates of [`chord_velocities`](Self::chord_velocities).

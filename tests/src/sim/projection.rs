@@ -10,23 +10,11 @@
 //! same metric to first order in its size (its Newton updates take $J$ at successive
 //! points).
 
-use pfaff::sim::{Formulation, Method, Simulation, StateSpace};
+use pfaff::sim::{Formulation, StateSpace};
 use pfaff::{LinearSolver, Mechanism};
 
 use crate::accuracy::util::Rng;
-
-/// A consistent moving state of `model` at `t` from its initial state (a tight run).
-fn moving_state(model: &dyn Mechanism, t: f64) -> (Vec<f64>, Vec<f64>) {
-    let run = Simulation::new(model)
-        .integrator(Method::Dop853)
-        .tolerances(1e-12, 1e-14)
-        .output_times(&[])
-        .run(t)
-        .expect("the reference run");
-    let (_, q, qd) = run.final_state().expect("a final row");
-    (q.to_vec(), qd.to_vec())
-}
-
+use crate::states::moving_state;
 fn norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0_f64, |s, x| s.max(x.abs()))
 }

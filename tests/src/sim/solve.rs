@@ -239,17 +239,22 @@ fn a_massless_coordinate_takes_the_general_path() {
     assert_eq!(generated, 0);
 }
 
+/// The built-in models but those with redundant constraints (Bricard's linkage, the
+/// parallelogram), whose augmented system the general path solves.
+fn generated_solve_models() -> impl Iterator<Item = &'static pfaff_models::Entry> {
+    let redundant = ["bricard", "parallelogram"];
+    pfaff_models::all()
+        .iter()
+        .filter(move |e| !redundant.contains(&e.name))
+}
+
 #[test]
 fn every_built_in_model_agrees_with_the_dense_path() {
     // Off the constraint manifold the redundant rows of Bricard's linkage and of the
     // parallelogram are nearly, not exactly, dependent: both paths solve an
     // ill-conditioned system there and agree only to its condition; on the manifold see
     // `redundant_constraints_take_the_general_path`.
-    let redundant = ["bricard", "parallelogram"];
-    for entry in pfaff_models::all()
-        .iter()
-        .filter(|e| !redundant.contains(&e.name))
-    {
+    for entry in generated_solve_models() {
         let model = (entry.make)();
         let n = agree(model.as_ref(), 11);
         eprintln!("{}: generated on {n} of 20", entry.name);
@@ -568,38 +573,26 @@ fn a_non_finite_input_never_gives_a_finite_generated_solution() {
     // and ÷ by a tested pivot, and inf·0 is NaN). Each entry of each built-in model
     // with a generated solve, one at a time, at a random state; an entry of M with its
     // mirror (M is symmetric, and the solve reads one triangle).
-    let redundant = ["bricard", "parallelogram"];
-    for entry in pfaff_models::all()
-        .iter()
-        .filter(|e| !redundant.contains(&e.name))
-    {
+    for entry in generated_solve_models() {
         let model = (entry.make)();
         let model = model.as_ref();
         let info = model.info();
-        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        let (n, mh) = (info.nq(), info.nh());
         let (q, qd) = states(model, 1, 31).remove(0);
-        let mut mass = vec![0.0; info.mass_pattern.len()];
-        let mut cq = vec![0.0; info.holonomic_pattern.len()];
-        let mut g = vec![0.0; info.nonholonomic_pattern.len()];
-        let mut b = vec![0.0; n + mh + mnh];
-        {
-            let (forces, gamma) = b.split_at_mut(n);
-            let (gh, gnh) = gamma.split_at_mut(mh);
-            model.dynamics_terms(
-                0.3,
-                &q,
-                &qd,
-                DynamicsTerms {
-                    holonomic: None,
-                    mass: &mut mass,
-                    forces,
-                    holonomic_jacobian: &mut cq,
-                    holonomic_gamma: gh,
-                    nonholonomic_matrix: &mut g,
-                    nonholonomic_gamma: gnh,
-                },
-            );
-        }
+        // [M, Q, C_q, γ_h, G, γ_nh] as one call writes them.
+        let all = terms(model, 0.3, &q, &qd, false);
+        let (lm, lc, lg) = (
+            info.mass_pattern.len(),
+            info.holonomic_pattern.len(),
+            info.nonholonomic_pattern.len(),
+        );
+        let (mass, rest) = all.split_at(lm);
+        let (forces, rest) = rest.split_at(n);
+        let (cq, rest) = rest.split_at(lc);
+        let (gh, rest) = rest.split_at(mh);
+        let (g, gnh) = rest.split_at(lg);
+        let (mass, cq, g) = (mass.to_vec(), cq.to_vec(), g.to_vec());
+        let b = [forces, gh, gnh].concat();
         let mut x = b.clone();
         match model.augmented_solve(&mass, &cq, &g, &mut x) {
             AugmentedSolve::Unavailable => continue,
