@@ -427,7 +427,7 @@ impl Dynamics {
         // The solution buffer leaves `self` for the call (a move of the vector, no
         // allocation) and comes back whatever the outcome.
         let mut out = std::mem::take(&mut self.out);
-        let stats = self.solve_evaluated(mech, ws, t, shift, None, &mut out);
+        let stats = self.solve_evaluated(mech, ws, t, shift, None, true, &mut out);
         if stats.is_ok() {
             qdd.copy_from_slice(&out[..n]);
             lambda.copy_from_slice(&out[n..]);
@@ -440,7 +440,7 @@ impl Dynamics {
     /// shift of $\gamma$) into `out`: `None` when it declines, has no generated solve
     /// (then not tried again) or leaves a non-finite entry, for the general path.
     #[inline]
-    pub(crate) fn try_generated<M: Mechanism + ?Sized>(
+    fn try_generated<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
         ws: &Workspace,
@@ -477,7 +477,12 @@ impl Dynamics {
     /// right-hand side is written there and solved in place, with no copy in between.
     /// `velocities`, when given, are those of the state (see [`Velocities`]): the
     /// redundant rows' check then allows for the rows that are dependent only near a
-    /// rank drop of $J$.
+    /// rank drop of $J$. Unless `terms_checked`, the terms have not been checked for
+    /// finiteness: the generated solve vouches for them by a finite solution, and
+    /// every other path checks them first ([`Workspace::check_dynamics_terms`]).
+    // The evaluated point's facts (shift, velocities, whether its terms are checked)
+    // beside the buffers: one caller each in the point and in `accelerations_shifted`.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn solve_evaluated<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -485,11 +490,19 @@ impl Dynamics {
         t: f64,
         shift: Option<&[f64]>,
         velocities: Option<Velocities<'_>>,
+        terms_checked: bool,
         out: &mut [f64],
     ) -> Result<AccelerationStats, DynamicsError> {
         let info = self.info;
         let m = info.nh() + info.nnh();
         self.redundant.clear();
+        // Unchecked terms go to the generated solve first, which vouches for them by a
+        // finite solution (see `sim::point::Point::accelerations`); every other path
+        // reads checked terms.
+        let vouch = !terms_checked && self.generated_solve();
+        if !terms_checked && !vouch {
+            ws.check_dynamics_terms(t)?;
+        }
 
         if let Some(split) = self.split.as_mut() {
             right_hand_side(ws, shift, &mut self.b);
@@ -520,6 +533,9 @@ impl Dynamics {
             if let Some(stats) = self.try_generated(mech, ws, shift, out) {
                 return Ok(stats);
             }
+        }
+        if vouch {
+            ws.check_dynamics_terms(t)?;
         }
         right_hand_side(ws, shift, &mut self.b);
         if self.dense_path && self.small.is_none() {

@@ -209,9 +209,6 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
     /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
     terms_checked: bool,
-    /// Whether the last solve of [`accelerations`](Self::accelerations) took a path
-    /// other than the generated one: the next checks its terms before solving.
-    declined: bool,
     /// $[\Delta q; \mu]$ of [`project_in_mass_metric`](Self::project_in_mass_metric).
     solution_scratch: Vec<f64>,
     /// Evaluations of the holonomic functions: $C$ alone, $C_q$ (with $G$) alone, both
@@ -271,7 +268,6 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             redundant: Vec::new(),
             constraints_with_terms: false,
             terms_checked: true,
-            declined: false,
             solution_scratch: vec![0.0; n + m],
             rank: 0,
         };
@@ -595,24 +591,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
         let redundant = self.rank > 0 && self.rank < self.info.nh();
-        // The terms just evaluated go to the generated solve unchecked: it declines, or
-        // leaves a non-finite entry in its solution, whenever one of them is not finite
-        // (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`), so
-        // a finite solution proves them finite. Otherwise they are checked first (which
-        // names a non-finite one), then solved by the general path.
-        if !self.terms_checked && !redundant && !self.declined && self.dynamics.generated_solve() {
-            if self
-                .dynamics
-                .try_generated(self.mech, &self.ws, shift, &mut self.solution)
-                .is_some()
-            {
-                self.terms_checked = true;
-                self.solved = state;
-                return Ok(());
-            }
-            self.declined = true;
-        }
-        self.check_terms(t)?;
+        // Terms just evaluated go to the solve unchecked: the generated solve declines,
+        // or leaves a non-finite entry in its solution, whenever one of them is not
+        // finite (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`),
+        // so a finite solution proves them finite; before any other path the solve
+        // checks them, naming a non-finite one.
+        let checked = self.terms_checked;
         if redundant {
             self.redundant_velocity_residuals(t)?;
         }
@@ -621,19 +605,25 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             qd: &self.qd,
             speed: inf_norm(&self.qd),
         });
-        let stats = self
-            .dynamics
-            .solve_evaluated(
-                self.mech,
-                &mut self.ws,
-                t,
-                shift,
-                velocities,
-                &mut self.solution,
-            )
-            .map_err(|e| SimErrorKind::from_analysis(e.into(), Vec::new()))?;
-        // The generated solve serves again: the next terms may skip their check.
-        self.declined = stats.path != SolverPath::Generated;
+        let stats = self.dynamics.solve_evaluated(
+            self.mech,
+            &mut self.ws,
+            t,
+            shift,
+            velocities,
+            checked,
+            &mut self.solution,
+        );
+        let stats = match stats {
+            Ok(stats) => stats,
+            Err(e) => {
+                if !checked {
+                    self.forget_terms();
+                }
+                return Err(SimErrorKind::from_analysis(e.into(), Vec::new()));
+            }
+        };
+        self.terms_checked = true;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
             self.dense = position;
@@ -714,19 +704,25 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms_checked {
             if let Err(e) = self.ws.check_dynamics_terms(t) {
-                for s in [
-                    &mut self.terms,
-                    &mut self.jacobian,
-                    &mut self.dense,
-                    &mut self.solved,
-                ] {
-                    *s = 0;
-                }
+                self.forget_terms();
                 return Err(SimErrorKind::from_eval(e));
             }
             self.terms_checked = true;
         }
         Ok(())
+    }
+
+    /// Forgets the dynamics terms and what was stamped from them (after they failed
+    /// their check).
+    fn forget_terms(&mut self) {
+        for s in [
+            &mut self.terms,
+            &mut self.jacobian,
+            &mut self.dense,
+            &mut self.solved,
+        ] {
+            *s = 0;
+        }
     }
 
     /// Stamps the $C$ the dynamics terms wrote, when it is finite (a non-finite one is
@@ -866,8 +862,9 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// augmented system (E31) with the right-hand sides $[0; -C; 0]$ and
     /// $[0; -(J\dot q + [C_t; g])]$: positions by the Newton updates
     /// $\Delta q = -M^{-1}J^\mathsf{T}(J M^{-1} J^\mathsf{T})^{-1}[C; 0]$ with $M$ of the
-    /// state to project (the integrator's last evaluation, so no evaluation of its
-    /// own) and $J$ at the latest positions (the non-holonomic rows ask $G\Delta q = 0$:
+    /// integrator's last evaluation (the state to project for DOP853, DOPRI5 and
+    /// Adams, a stage of the step otherwise: no evaluation of its own) and $J$ at the
+    /// latest positions (the non-holonomic rows ask $G\Delta q = 0$:
     /// the correction is one the velocity constraints admit), until the constraints
     /// are met to the Newton tolerance; then the velocities by one update with $J$ at
     /// the corrected positions, which meets $J\dot q + [C_t; g] = 0$ to round-off. The
@@ -883,8 +880,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             return Ok(false);
         }
         let eval = SimErrorKind::from_eval;
-        // M (and J) of the kept state: normally the integrator's last evaluation.
-        self.dynamics_terms(t)?;
+        // M of the integrator's last evaluation: at the kept state for DOP853, DOPRI5
+        // and Adams, at a stage of the step for the others (a metric as good, and no
+        // evaluation of its own); the terms at the kept state when none is held.
+        if self.terms == 0 {
+            self.dynamics_terms(t)?;
+        } else {
+            self.check_terms(t)?;
+        }
         let tol = self.newton.tolerance;
         let mut previous = f64::INFINITY;
         let mut met = false;
@@ -899,13 +902,17 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
                 met = true;
                 break;
             }
-            // Not falling (or NaN): the orthogonal projection takes over.
-            if update == Self::MASS_UPDATES
-                || residual.partial_cmp(&previous) != Some(Ordering::Less)
-            {
+            // Not falling (or NaN): the orthogonal projection takes over, from the
+            // better of the last two iterates.
+            let falling = residual.partial_cmp(&previous) == Some(Ordering::Less);
+            if !falling && update > 0 {
+                self.q.copy_from_slice(&self.dx);
+            }
+            if update == Self::MASS_UPDATES || !falling {
                 break;
             }
             previous = residual;
+            self.dx.copy_from_slice(&self.q);
             let rows = &mut self.solution_scratch[n..];
             rows[..mh].copy_from_slice(c);
             rows[mh..].fill(0.0);
@@ -917,7 +924,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if !met {
             return Ok(false);
         }
-        // Velocities: one update with J at the corrected positions is exact.
+        // Velocities: one update with J at the corrected positions is exact but for the
+        // rounding of the solve (pivots at least 1e-8 of their diagonals). It is not
+        // checked here: a check cost 4–8 % of a run and never fired (ARCHITECTURE.md),
+        // and the monitors evaluate the velocity residuals at every kept state anyway
+        // (`Run::monitors`, the largest velocity violation).
         self.velocity_residuals(t).map_err(eval)?;
         self.solution_scratch[n..].copy_from_slice(&self.vel);
         Ok(self.mass_metric_update(false))
