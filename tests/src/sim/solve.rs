@@ -626,5 +626,9 @@ fn a_non_finite_input_never_gives_a_finite_generated_solution() {
         assert!(tried > 0, "{}: no entry tried", info.name);
     }
     // Every built-in model but the two redundant ones has a generated solve.
-    assert_eq!(models, pfaff_models::all().len() - 2, "models with a generated solve");
+    assert_eq!(
+        models,
+        pfaff_models::all().len() - 2,
+        "models with a generated solve"
+    );
 }
