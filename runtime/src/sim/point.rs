@@ -174,7 +174,8 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// `lu_v` (all of `rows`) the sparsity of $J$ leaves (see [`GramPlan`]).
     gram_h: GramPlan,
     gram_v: GramPlan,
-    /// Scratch of a velocity update.
+    /// Scratch of a velocity update, and the previous iterate of the positions in
+    /// [`project_in_mass_metric`](Self::project_in_mass_metric).
     dx: Vec<f64>,
     /// $M$ for [`free_accelerations`](Self::free_accelerations) (sized on first use).
     mass: SmallCholesky,
