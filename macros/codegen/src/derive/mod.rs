@@ -278,6 +278,7 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
     if let Some(bl) = &body_level {
         mass = merge_mass(g, &mass, &bl.mass);
     }
+    let mass = symmetric_mass(&mass);
     let zero_q = g.constant(0.0);
     let mut forces = Vec::with_capacity(n);
     let mut applied_forces = Vec::with_capacity(n);
@@ -593,6 +594,34 @@ fn merge_mass(g: &mut Graph, a: &[Entry], b: &[(u32, u32, ExprId)]) -> Vec<Entry
             let expr = g.add(terms);
             (!(g.is_canonical() && g.is_zero(expr))).then_some(Entry { row, col, expr })
         })
+        .collect()
+}
+
+/// The mass matrix with each entry below the diagonal the expression of its mirror
+/// above it (one that has none gives its own to the mirror), in row-major order.
+///
+/// $M_{ij} = \partial^2 T/\partial\dot q_i\partial\dot q_j$ is symmetric, but the
+/// two derivatives are taken in opposite orders and, after simplification, need not be
+/// the same expression: evaluated, the triangles could differ in their last bits, and
+/// the generated code would compute both. With one expression per pair the generated
+/// $M$ is exactly symmetric (what the generated solve, which reads one triangle, and
+/// every symmetric factorization assume) and each pair is computed once.
+fn symmetric_mass(mass: &[Entry]) -> Vec<Entry> {
+    let mut by_place: std::collections::BTreeMap<(u32, u32), ExprId> =
+        mass.iter().map(|e| ((e.row, e.col), e.expr)).collect();
+    for e in mass {
+        let (upper, lower) = if e.row <= e.col {
+            ((e.row, e.col), (e.col, e.row))
+        } else {
+            ((e.col, e.row), (e.row, e.col))
+        };
+        let expr = by_place.get(&upper).copied().unwrap_or(e.expr);
+        by_place.insert(upper, expr);
+        by_place.insert(lower, expr);
+    }
+    by_place
+        .into_iter()
+        .map(|((row, col), expr)| Entry { row, col, expr })
         .collect()
 }
 
