@@ -633,3 +633,53 @@ fn row_of(entries: &[Entry], r: usize) -> Vec<Entry> {
         .copied()
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{symmetric_mass, Entry};
+    use crate::sym::{Graph, Var};
+
+    fn entry(row: u32, col: u32, expr: crate::sym::ExprId) -> Entry {
+        Entry { row, col, expr }
+    }
+
+    /// Each entry below the diagonal takes its mirror's expression; an entry whose
+    /// mirror is missing (one of the two derivatives simplified to zero, the other not)
+    /// gives it its own; the order is row-major.
+    #[test]
+    fn mirror_entries_share_one_expression() {
+        let mut g = Graph::new();
+        let (a, b, c, d, e) = (
+            g.var(Var::Q(0)),
+            g.var(Var::Q(1)),
+            g.constant(2.0),
+            g.constant(3.0),
+            g.constant(5.0),
+        );
+        // M[0,1] = a and M[1,0] = b (the same value in exact arithmetic, say), M[2,0]
+        // without M[0,2], and the diagonal.
+        let mass = [
+            entry(0, 0, c),
+            entry(0, 1, a),
+            entry(1, 0, b),
+            entry(1, 1, d),
+            entry(2, 0, e),
+            entry(2, 2, c),
+        ];
+        let sym = symmetric_mass(&mass);
+        let places: Vec<(u32, u32, crate::sym::ExprId)> =
+            sym.iter().map(|x| (x.row, x.col, x.expr)).collect();
+        assert_eq!(
+            places,
+            vec![
+                (0, 0, c),
+                (0, 1, a),
+                (0, 2, e),
+                (1, 0, a),
+                (1, 1, d),
+                (2, 0, e),
+                (2, 2, c),
+            ]
+        );
+    }
+}
