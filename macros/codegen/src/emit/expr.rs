@@ -133,7 +133,8 @@ impl Printer<'_> {
 
     /// The statement defining temporary `k`, node `id`: a `let` (or an element of
     /// [`Printer::array`]). Of a [`Program::partner`] pair `sin u`, `cos u`, the first
-    /// defines both with one `sin_cos` call and the second nothing.
+    /// defines both with one `sin_cos` call and the second nothing; of two
+    /// [`Program::twins`], the first defines both pairs with one `sin_cos2` call.
     pub fn define(&self, k: usize, id: ExprId) -> TokenStream {
         let place = |k: usize| match &self.array {
             Some(array) => {
@@ -158,11 +159,7 @@ impl Printer<'_> {
             if j < k {
                 return TokenStream::new();
             }
-            let (sin, cos, u) = match self.g.node(id) {
-                Node::Call(Func::Sin, u) => (k, j, *u),
-                Node::Call(Func::Cos, u) => (j, k, *u),
-                _ => unreachable!("pairs are a sine and a cosine"),
-            };
+            let (sin, cos, u) = self.pair(id);
             let (sin, cos) = (place(sin), place(cos));
             if let Some(sum) = self.prog.angle_sums.get(&id) {
                 let [sa, ca, sb, cb] = sum.pairs.map(|p| {
@@ -176,12 +173,38 @@ impl Printer<'_> {
                     quote!(#let_ #sin = #sa * #cb + #ca * #sb; #let_ #cos = #ca * #cb - #sa * #sb;)
                 };
             }
+            if let Some(&twin) = self.prog.twins.get(&id) {
+                let m = self.prog.temp(twin).expect("twins are temporaries");
+                if m < k {
+                    // Defined with the earlier pair.
+                    return TokenStream::new();
+                }
+                let (sin2, cos2, u2) = self.pair(twin);
+                let (sin2, cos2) = (place(sin2), place(cos2));
+                let (u, _) = self.expr(u, false);
+                let (u2, _) = self.expr(u2, false);
+                return quote!(
+                    #let_ ((#sin, #cos), (#sin2, #cos2)) = ::pfaff::math::sin_cos2(#u, #u2);
+                );
+            }
             let (u, _) = self.expr(u, false);
             return quote!(#let_ (#sin, #cos) = ::pfaff::math::sin_cos(#u););
         }
         let (ts, _) = self.expr(id, true);
         let place = place(k);
         quote!(#let_ #place = #ts;)
+    }
+
+    /// The temporaries `(sin u, cos u)` of the [`Program::partner`] pair of `id`, and
+    /// `u`.
+    fn pair(&self, id: ExprId) -> (usize, usize, ExprId) {
+        let other = self.prog.partner[&id];
+        let temp = |e| self.prog.temp(e).expect("both of a pair are temporaries");
+        match self.g.node(id) {
+            Node::Call(Func::Sin, u) => (temp(id), temp(other), *u),
+            Node::Call(Func::Cos, u) => (temp(other), temp(id), *u),
+            _ => unreachable!("pairs are a sine and a cosine"),
+        }
     }
 
     /// An operand in receiver position (`x` in `x.sin()`).

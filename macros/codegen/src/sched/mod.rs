@@ -18,7 +18,10 @@
 //! **Sine–cosine pairs.** Where both `sin u` and `cos u` of one argument are live, both
 //! get a temporary (even when used once) and the pair is recorded in
 //! [`Program::partner`]: the emitter defines the two with one call of
-//! `::pfaff::math::sin_cos`, which reduces `u` once.
+//! `::pfaff::math::sin_cos`, which reduces `u` once. Pairs of plain variables (a
+//! joint angle) go two by two, in schedule order, into [`Program::twins`]: the emitter
+//! defines two such pairs with one call of `::pfaff::math::sin_cos2`, which computes
+//! both in the two lanes of a register (bitwise the results of two calls).
 
 mod runs;
 
@@ -49,6 +52,10 @@ pub struct Program {
     pub partner: HashMap<ExprId, ExprId>,
     /// The pairs defined from the pairs of two angles they sum, by sine and by cosine.
     pub angle_sums: HashMap<ExprId, AngleSum>,
+    /// For the defining member (the earlier temporary) of a [`partner`](Self::partner)
+    /// pair of a plain variable, that of the pair it shares a `sin_cos2` call with, and
+    /// the other way round: the earlier of the two defines both.
+    pub twins: HashMap<ExprId, ExprId>,
 }
 
 impl Program {
@@ -65,7 +72,8 @@ impl Program {
 
     /// The nodes and the variables (as leaves) that `roots`, some of this program's,
     /// need: what a function must compute when only those outputs are asked for. A
-    /// sine needs its paired cosine and the other way round (one call defines both).
+    /// sine needs its paired cosine and the other way round (one call defines both),
+    /// and a pair its twin.
     /// Every other node is needed only by the remaining roots.
     pub fn needed(&self, g: &Graph, roots: &[ExprId]) -> (Vec<bool>, BTreeSet<Var>) {
         let mut needed = vec![false; g.len()];
@@ -77,6 +85,9 @@ impl Program {
             }
             needed[id.index()] = true;
             if let Some(&other) = self.partner.get(&id) {
+                stack.push(other);
+            }
+            if let Some(&other) = self.twins.get(&id) {
                 stack.push(other);
             }
             if let Some(sum) = self.angle_sums.get(&id) {
@@ -155,6 +166,7 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
         .values()
         .flat_map(|(r, _)| r.iter().map(|r| r.first))
         .collect();
+    let twins = twins(g, &lets, &temp_of, &partner, &angle_sums);
     Program {
         vars,
         lets,
@@ -164,7 +176,36 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
         run_vars,
         partner,
         angle_sums,
+        twins,
     }
+}
+
+/// [`Program::twins`]: the defining members of the sine–cosine pairs whose argument is
+/// a variable (read at the top of the function, so available wherever the earlier of
+/// two is defined), two by two in schedule order, each mapped to the other.
+fn twins(
+    g: &Graph,
+    lets: &[ExprId],
+    temp_of: &[Option<usize>],
+    partner: &HashMap<ExprId, ExprId>,
+    angle_sums: &HashMap<ExprId, AngleSum>,
+) -> HashMap<ExprId, ExprId> {
+    let defining = lets.iter().enumerate().filter_map(|(k, &id)| {
+        let other = *partner.get(&id)?;
+        let first = temp_of[other.index()].is_some_and(|j| j > k);
+        let u = match g.node(id) {
+            Node::Call(Func::Sin | Func::Cos, u) => *u,
+            _ => return None,
+        };
+        (first && !angle_sums.contains_key(&id) && matches!(g.node(u), Node::Var(_))).then_some(id)
+    });
+    let defining: Vec<ExprId> = defining.collect();
+    let mut twins = HashMap::new();
+    for two in defining.chunks_exact(2) {
+        twins.insert(two[0], two[1]);
+        twins.insert(two[1], two[0]);
+    }
+    twins
 }
 
 /// The post-order of the live nodes of `roots`. A sum with runs (found over `slots`
@@ -310,5 +351,42 @@ mod tests {
         let p = schedule(&g, &[sa, ca, sb, ss, cs]);
         assert!(p.angle_sums.is_empty());
         assert_eq!(p.partner.get(&ss), Some(&cs));
+    }
+
+    /// The pairs of variables go two by two into one `sin_cos2` (the earlier defines
+    /// both), an odd one out stays a `sin_cos`, a pair of an expression or of a sum of
+    /// angles is never a twin, and a twin is needed with its twin.
+    #[test]
+    fn pairs_of_variables_are_twinned_in_schedule_order() {
+        let mut g = Graph::new();
+        let v: Vec<ExprId> = (0..3).map(|i| g.var(Var::Q(i))).collect();
+        let pair = |g: &mut Graph, u| (g.call(Func::Sin, u), g.call(Func::Cos, u));
+        let (s0, c0) = pair(&mut g, v[0]);
+        let (s1, c1) = pair(&mut g, v[1]);
+        let (s2, c2) = pair(&mut g, v[2]);
+        let two = g.constant(2.0);
+        let doubled = g.mul(vec![two, v[2]]);
+        let (sx, cx) = pair(&mut g, doubled);
+        let sum = g.add(vec![v[0], v[1]]);
+        let (ss, cs) = pair(&mut g, sum);
+        let p = schedule(&g, &[s0, c0, s1, c1, s2, c2, sx, cx, ss, cs]);
+        let defining = |s: ExprId, c: ExprId| {
+            if p.temp(s) < p.temp(c) {
+                s
+            } else {
+                c
+            }
+        };
+        let (d0, d1, d2) = (defining(s0, c0), defining(s1, c1), defining(s2, c2));
+        assert_eq!(p.twins.get(&d0), Some(&d1));
+        assert_eq!(p.twins.get(&d1), Some(&d0));
+        assert_eq!(p.twins.len(), 2, "{:?}", p.twins);
+        for id in [d2, sx, cx, ss, cs] {
+            assert!(!p.twins.contains_key(&id));
+        }
+        let (needed, vars) = p.needed(&g, &[c1]);
+        assert!([s0, c0, s1, c1].iter().all(|o| needed[o.index()]));
+        assert!(!needed[s2.index()] && !needed[sx.index()]);
+        assert_eq!(vars, BTreeSet::from([Var::Q(0), Var::Q(1)]));
     }
 }
