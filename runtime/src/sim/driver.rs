@@ -144,16 +144,30 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
 
     /// Adds a row at the integrator's last accepted state when the rows end before it
     /// (output on a grid, or only at the end), so that a partial run ends where the
-    /// integration stopped. Skipped when the state cannot be reconstructed.
+    /// integration stopped. Skipped when the state cannot be reconstructed. When its
+    /// accelerations fail (often the failure being reported: the solve at the kept
+    /// state), the row has the positions and velocities, their violations and energy,
+    /// and NaN multipliers.
     fn record_last_accepted(&mut self, stepper: &Stepper) {
         let t = stepper.t();
         if self.traj.t.last().is_some_and(|&last| last >= t) || self.y.len() != stepper.y().len() {
             return;
         }
         self.y.copy_from_slice(stepper.y());
-        if self.sys.keep(t, self.y).is_ok() {
-            let _ = self.record(t);
+        if self.sys.keep(t, self.y).is_ok() && self.record(t).is_err() {
+            self.record_state(t);
         }
+    }
+
+    /// Records a row at the current positions and velocities without their
+    /// accelerations: NaN multipliers (violations NaN too if they cannot be evaluated).
+    fn record_state(&mut self, t: f64) {
+        let v = self.observe(t).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        let p = &self.sys.point;
+        let energy = self.monitors.energy_final.filter(|_| p.info.conservative);
+        let lambda = vec![f64::NAN; p.lambda().len()];
+        self.traj
+            .push(t, &p.q, &p.qd, &lambda, v.0, v.1.max(v.2), energy);
     }
 
     /// The run so far; moves the recorded rows and lists out (the recorder is not

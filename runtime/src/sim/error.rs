@@ -202,6 +202,15 @@ impl SimErrorKind {
             Self::Impact(
                 crate::ImpactError::Singular { t, .. } | crate::ImpactError::SingularMass { t, .. },
             ) => Some(*t),
+            Self::Analysis(Error::Dynamics(
+                DynamicsError::Singular { t, .. } | DynamicsError::InconsistentRedundant { t, .. },
+            )) => Some(*t),
+            Self::Analysis(Error::Kinematics(
+                KinematicsError::NewtonFailed { t, .. }
+                | KinematicsError::SingularDependent { t, .. }
+                | KinematicsError::SingularVelocity { t, .. }
+                | KinematicsError::BranchSwitch { t, .. },
+            )) => Some(*t),
             _ => None,
         }
     }
