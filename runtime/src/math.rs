@@ -159,6 +159,55 @@ fn quadrant(q: u64, s: u64, c: u64) -> (f64, f64) {
 /// Round to the nearest integer by adding and removing 1.5·2⁵² (see [`rem_pio2`]).
 const SHIFT: f64 = 6_755_399_441_055_744.0;
 
+/// The first part of [`rem_pio2`] on two lanes `x`, with the lane operations `add`,
+/// `sub`, `mul` and the broadcast `k`: `(shifted, r, w, y₀)`, from which `n` is the low
+/// word of `shifted` and `y₁ = (r − y₀) − w`. Shared by the two passes of
+/// [`sin_cos2`], so that both run the scalar operations in their order.
+macro_rules! reduce2 {
+    ($x:expr, $add:ident, $sub:ident, $mul:ident, $k:ident) => {{
+        let shifted = $add($mul($x, $k(INV_PIO2)), $k(SHIFT));
+        let f = $sub(shifted, $k(SHIFT));
+        let r = $sub($x, $mul(f, $k(PIO2_1)));
+        let w = $mul(f, $k(PIO2_1T));
+        (shifted, r, w, $sub(r, w))
+    }};
+}
+
+/// [`kernels`] on two lanes `(y₀, y₁)`, operation for operation: `(sin, cos)`.
+macro_rules! kernels2 {
+    ($y0:expr, $y1:expr, $add:ident, $sub:ident, $mul:ident, $k:ident) => {{
+        let (y0, y1) = ($y0, $y1);
+        let z = $mul(y0, y0);
+        let wz = $mul(z, z);
+        let rs = $add(
+            $add($k(S2), $mul(z, $add($k(S3), $mul(z, $k(S4))))),
+            $mul($mul(z, wz), $add($k(S5), $mul(z, $k(S6)))),
+        );
+        let v = $mul(z, y0);
+        let sn = $sub(
+            y0,
+            $sub(
+                $sub($mul(z, $sub($mul($k(0.5), y1), $mul(v, rs))), y1),
+                $mul(v, $k(S1)),
+            ),
+        );
+        let rc = $add(
+            $mul(z, $add($k(C1), $mul(z, $add($k(C2), $mul(z, $k(C3)))))),
+            $mul(
+                $mul(wz, wz),
+                $add($k(C4), $mul(z, $add($k(C5), $mul(z, $k(C6))))),
+            ),
+        );
+        let hz = $mul($k(0.5), z);
+        let wc = $sub($k(1.0), hz);
+        let cs = $add(
+            wc,
+            $add($sub($sub($k(1.0), wc), hz), $sub($mul(z, rc), $mul(y0, y1))),
+        );
+        (sn, cs)
+    }};
+}
+
 /// [`sin_cos2`] on two-element arrays: the portable pass, and the reference of the
 /// SSE2 one in the tests.
 #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
@@ -190,40 +239,12 @@ mod lanes {
             return (sin_cos(x0), sin_cos(x1));
         }
         let x = [x0, x1];
-        let shifted = add(mul(x, k(INV_PIO2)), k(SHIFT));
-        let f = sub(shifted, k(SHIFT));
-        let r = sub(x, mul(f, k(PIO2_1)));
-        let w = mul(f, k(PIO2_1T));
-        let y0 = sub(r, w);
+        let (shifted, r, w, y0) = reduce2!(x, add, sub, mul, k);
         if lost(h0, y0[0]) > 16 || lost(h1, y0[1]) > 16 {
             return (sin_cos(x0), sin_cos(x1));
         }
         let y1 = sub(sub(r, y0), w);
-        // The kernels of `kernels`, operation for operation.
-        let z = mul(y0, y0);
-        let wz = mul(z, z);
-        let rs = add(
-            add(k(S2), mul(z, add(k(S3), mul(z, k(S4))))),
-            mul(mul(z, wz), add(k(S5), mul(z, k(S6)))),
-        );
-        let v = mul(z, y0);
-        let sn = sub(
-            y0,
-            sub(
-                sub(mul(z, sub(mul(k(0.5), y1), mul(v, rs))), y1),
-                mul(v, k(S1)),
-            ),
-        );
-        let rc = add(
-            mul(z, add(k(C1), mul(z, add(k(C2), mul(z, k(C3)))))),
-            mul(mul(wz, wz), add(k(C4), mul(z, add(k(C5), mul(z, k(C6)))))),
-        );
-        let hz = mul(k(0.5), z);
-        let wc = sub(k(1.0), hz);
-        let cs = add(
-            wc,
-            add(sub(sub(k(1.0), wc), hz), sub(mul(z, rc), mul(y0, y1))),
-        );
+        let (sn, cs) = kernels2!(y0, y1, add, sub, mul, k);
         let lane = |i: usize| {
             let q = u64::from(shifted[i].to_bits() as u32);
             quadrant(q, sn[i].to_bits(), cs[i].to_bits())
@@ -269,40 +290,13 @@ mod sse2 {
         let k = |a: f64| _mm_set1_pd(a);
         let (add, sub, mul) = (_mm_add_pd, _mm_sub_pd, _mm_mul_pd);
         let x = _mm_set_pd(x1, x0);
-        let shifted = add(mul(x, k(INV_PIO2)), k(SHIFT));
-        let f = sub(shifted, k(SHIFT));
-        let r = sub(x, mul(f, k(PIO2_1)));
-        let w = mul(f, k(PIO2_1T));
-        let y0 = sub(r, w);
+        let (shifted, r, w, y0) = reduce2!(x, add, sub, mul, k);
         let [y00, y01] = split(y0);
         if lost(h0, y00) > 16 || lost(h1, y01) > 16 {
             return (sin_cos(x0), sin_cos(x1));
         }
         let y1 = sub(sub(r, y0), w);
-        let z = mul(y0, y0);
-        let wz = mul(z, z);
-        let rs = add(
-            add(k(S2), mul(z, add(k(S3), mul(z, k(S4))))),
-            mul(mul(z, wz), add(k(S5), mul(z, k(S6)))),
-        );
-        let v = mul(z, y0);
-        let sn = sub(
-            y0,
-            sub(
-                sub(mul(z, sub(mul(k(0.5), y1), mul(v, rs))), y1),
-                mul(v, k(S1)),
-            ),
-        );
-        let rc = add(
-            mul(z, add(k(C1), mul(z, add(k(C2), mul(z, k(C3)))))),
-            mul(mul(wz, wz), add(k(C4), mul(z, add(k(C5), mul(z, k(C6)))))),
-        );
-        let hz = mul(k(0.5), z);
-        let wc = sub(k(1.0), hz);
-        let cs = add(
-            wc,
-            add(sub(sub(k(1.0), wc), hz), sub(mul(z, rc), mul(y0, y1))),
-        );
+        let (sn, cs) = kernels2!(y0, y1, add, sub, mul, k);
         let qi = _mm_castpd_si128(shifted);
         let q = [
             _mm_cvtsi128_si64(qi) as u64,
