@@ -411,6 +411,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let mut y_start = vec![0.0; if refine_events { dim } else { 0 }];
     let mut next_out = 0;
     let steps_mode = matches!(sim.output, Output::Steps);
+    // The state each step starts from, and the one the last accepted step started
+    // from: a step that ends at a state no evaluation succeeds from is taken back.
+    let mut from = vec![0.0; dim];
+    let mut back = vec![0.0; dim];
+    let mut t_back = f64::NAN;
+    let mut step_backs = 0_u32;
 
     macro_rules! bail {
         ($kind:expr) => {
@@ -445,10 +451,34 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             let next = times.get(next_out).copied().unwrap_or(f64::INFINITY);
             stepper.dense_output_from(Some(next));
         }
+        from.copy_from_slice(stepper.y());
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
                 let kind = failure(e, &mut rec.sys);
+                // An accepted state next to a rank drop of C_q from which every
+                // attempt fails the dropped rows' check (ARCHITECTURE.md, "Through a
+                // rank drop"): the step that reached it is taken back and redone
+                // from where it started with half its size, a few times at most.
+                if step_backs < MAX_STEP_BACKS
+                    && t_back < t_prev
+                    && rec.sys.point.has_redundant_rows()
+                    && rank_drop_failure(&kind)
+                {
+                    step_backs += 1;
+                    rec.traj.truncate_after(t_back);
+                    next_out = times.partition_point(|&to| to <= t_back);
+                    check!(rec.sys.keep(t_back, &back));
+                    check!(rec.sys.accept(t_back));
+                    rec.sys.gather(rec.y);
+                    let h0 = 0.5 * (t_prev - t_back);
+                    if let Err(e) = stepper.reset(&mut rec.sys, t_back, rec.y, Some(h0)) {
+                        let kind = failure(e, &mut rec.sys);
+                        bail!(kind)
+                    }
+                    t_back = f64::NAN;
+                    continue;
+                }
                 bail!(kind)
             }
         };
@@ -531,6 +561,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 check!(c.anchor(&rec.sys.point, te));
             }
             rec.sys.gather(rec.y);
+            t_back = f64::NAN;
             if let Err(e) = stepper.reset(&mut rec.sys, te, rec.y, restart_step(h0)) {
                 let kind = failure(e, &mut rec.sys);
                 bail!(kind)
@@ -588,6 +619,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             check!(rec.record(to));
             next_out += 1;
         }
+        back.copy_from_slice(&from);
+        t_back = t_prev;
         if let Some(f) = sim.progress.as_mut() {
             f(t);
         }
@@ -598,6 +631,24 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         check!(rec.record(t_end));
     }
     Ok(rec.run(Some(&stepper)))
+}
+
+/// Most steps a run takes back ([`rank_drop_failure`]).
+const MAX_STEP_BACKS: u32 = 8;
+
+/// Whether a step's failure can be the one of a state next to a rank drop of $C_q$:
+/// the dropped rows' check failing at every attempt (reported as such, or as the step
+/// size's underflow that the retries end in), or the position iteration stalling there
+/// on the singular Jacobian.
+fn rank_drop_failure(kind: &SimErrorKind) -> bool {
+    matches!(
+        kind,
+        SimErrorKind::StepSizeTooSmall { .. }
+            | SimErrorKind::NewtonFailed { .. }
+            | SimErrorKind::Analysis(crate::Error::Dynamics(
+                crate::DynamicsError::InconsistentRedundant { .. }
+            ))
+    )
 }
 
 /// A NaN met during assembly is a [`SimErrorKind::NonFinite`]; other failures are

@@ -578,6 +578,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok((c, inf_norm(&self.vel[..mh]), inf_norm(&self.vel[mh..])))
     }
 
+    /// Whether assembly found the holonomic constraints dependent (a redundant set,
+    /// whose rank can also drop along the motion).
+    pub(crate) fn has_redundant_rows(&self) -> bool {
+        self.rank > 0 && self.rank < self.info.nh()
+    }
+
     /// $\ddot q$ and $\lambda$ at the current state from (E31), with $\gamma$ replaced
     /// by $\gamma + s$ when `shift` gives $s$ (Baumgarte); the terms come from one call
     /// of the model's fused evaluation.
@@ -591,7 +597,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.factorizations += 1;
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
-        let redundant = self.rank > 0 && self.rank < self.info.nh();
+        let redundant = self.has_redundant_rows();
         // Terms just evaluated go to the solve unchecked: the generated solve declines,
         // or leaves a non-finite entry in its solution, whenever one of them is not
         // finite (`sim::solve::a_non_finite_input_never_gives_a_finite_generated_solution`),

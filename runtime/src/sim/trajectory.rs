@@ -47,6 +47,21 @@ impl Trajectory {
         }
     }
 
+    /// Drops the rows after time `t` (the rows of a step taken back).
+    pub(crate) fn truncate_after(&mut self, t: f64) {
+        let rows = self.t.partition_point(|&r| r <= t);
+        let (n, m) = (self.info.nq(), self.info.nh() + self.info.nnh());
+        self.t.truncate(rows);
+        self.q.truncate(rows * n);
+        self.qd.truncate(rows * n);
+        self.lambda.truncate(rows * m);
+        self.position_violation.truncate(rows);
+        self.velocity_violation.truncate(rows);
+        if self.info.conservative {
+            self.energy.truncate(rows);
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn push(
         &mut self,
