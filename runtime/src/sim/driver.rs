@@ -459,10 +459,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 // An accepted state next to a rank drop of C_q from which every
                 // attempt fails the dropped rows' check (ARCHITECTURE.md, "Through a
                 // rank drop"): the step that reached it is taken back and redone
-                // from where it started with half its size, a few times at most.
+                // from where it started with half its size, a few times at most. Not
+                // with contacts, whose resting set and anchors follow the steps.
                 if step_backs < MAX_STEP_BACKS
                     && t_back < t_prev
                     && rec.sys.point.has_redundant_rows()
+                    && rec.sys.contacts.is_none()
                     && rank_drop_failure(&kind)
                 {
                     step_backs += 1;
