@@ -412,9 +412,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let mut next_out = 0;
     let steps_mode = matches!(sim.output, Output::Steps);
     // The state each step starts from, and the one the last accepted step started
-    // from: a step that ends at a state no evaluation succeeds from is taken back.
-    let mut from = vec![0.0; dim];
-    let mut back = vec![0.0; dim];
+    // from: a step that ends at a state no evaluation succeeds from is taken back
+    // (models with redundant constraints and no contacts, see below).
+    let steps_back = rec.sys.point.has_redundant_rows() && rec.sys.contacts.is_none();
+    let mut from = vec![0.0; if steps_back { dim } else { 0 }];
+    let mut back = from.clone();
     let mut t_back = f64::NAN;
     let mut step_backs = 0_u32;
 
@@ -451,7 +453,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             let next = times.get(next_out).copied().unwrap_or(f64::INFINITY);
             stepper.dense_output_from(Some(next));
         }
-        from.copy_from_slice(stepper.y());
+        if steps_back {
+            from.copy_from_slice(stepper.y());
+        }
         let t = match stepper.step(&mut rec.sys, Some(t_end)) {
             Ok(t) => t,
             Err(e) => {
@@ -459,10 +463,11 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 // An accepted state next to a rank drop of C_q from which every
                 // attempt fails the dropped rows' check (ARCHITECTURE.md, "Through a
                 // rank drop"): the step that reached it is taken back and redone
-                // from where it started with half its size, a few times at most.
-                if step_backs < MAX_STEP_BACKS
+                // from where it started with half its size, a few times at most. Not
+                // with contacts, whose resting set and anchors follow the steps.
+                if steps_back
+                    && step_backs < MAX_STEP_BACKS
                     && t_back < t_prev
-                    && rec.sys.point.has_redundant_rows()
                     && rank_drop_failure(&kind)
                 {
                     step_backs += 1;
@@ -619,8 +624,10 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             check!(rec.record(to));
             next_out += 1;
         }
-        back.copy_from_slice(&from);
-        t_back = t_prev;
+        if steps_back {
+            std::mem::swap(&mut back, &mut from);
+            t_back = t_prev;
+        }
         if let Some(f) = sim.progress.as_mut() {
             f(t);
         }
