@@ -49,7 +49,7 @@ use crate::linalg::dense::DenseLu;
 use crate::linalg::elimination::Elimination;
 use crate::linalg::inf_norm;
 use crate::linalg::small::SmallLu;
-use crate::linalg::sparse::SparseKkt;
+use crate::linalg::sparse::{SparseKkt, SparseLdlt};
 use crate::workspace::{
     all_finite, check_finite, check_len, check_same_model, check_state, EvalError, Quantity,
     Workspace,
@@ -66,8 +66,12 @@ pub enum LinearSolver {
     Auto,
     /// Always dense.
     Dense,
-    /// Always sparse.
+    /// Always sparse: the $LDL^\mathsf{T}$ in the generated solve's order when its pivots
+    /// pass, the $LU$ otherwise.
     Sparse,
+    /// Always the sparse $LU$ (the general path of large models before the
+    /// $LDL^\mathsf{T}$; kept for comparisons).
+    SparseLu,
 }
 
 /// Tuning of [`Dynamics`].
@@ -125,6 +129,8 @@ pub enum SolverPath {
     Dense,
     /// Sparse $LU$.
     Sparse,
+    /// Sparse $LDL^\mathsf{T}$, coordinates eliminated first.
+    SparseLdlt,
     /// Rank-deficient $J$: reduced system and minimum-norm multipliers.
     Redundant,
 }
@@ -196,6 +202,9 @@ pub struct Dynamics {
     small: Option<SmallLu>,
     dense: Option<DenseLu>,
     sparse: Option<SparseKkt>,
+    /// The sparse $LDL^\mathsf{T}$ tried before the sparse $LU$ (`None` for
+    /// [`LinearSolver::SparseLu`], and when its symbolic factorization is not possible).
+    ldlt: Option<SparseLdlt>,
     /// Whether to try the model's generated solve (cleared when it has none).
     generated: bool,
     x: Vec<f64>,
@@ -332,7 +341,7 @@ impl Dynamics {
         let dim = info.nq() + info.nh() + info.nnh();
         let (dense, sparse) = match params.solver {
             LinearSolver::Dense => (true, false),
-            LinearSolver::Sparse => (false, true),
+            LinearSolver::Sparse | LinearSolver::SparseLu => (false, true),
             LinearSolver::Auto => (dim < params.crossover, dim >= params.crossover),
         };
         let sparse = if sparse {
@@ -340,6 +349,11 @@ impl Dynamics {
                 model: info.name,
                 reason: format!("{e:?}"),
             })?)
+        } else {
+            None
+        };
+        let ldlt = if sparse.is_some() && params.solver != LinearSolver::SparseLu {
+            SparseLdlt::new(info)
         } else {
             None
         };
@@ -351,6 +365,7 @@ impl Dynamics {
             small: eager.then(|| SmallLu::new(dim)),
             dense: eager.then(|| DenseLu::new(dim, 1)),
             sparse,
+            ldlt,
             generated: params.solver == LinearSolver::Auto,
             x: vec![0.0; dim],
             b: vec![0.0; dim],
@@ -572,7 +587,21 @@ impl Dynamics {
             }
         } else if let Some(kkt) = self.sparse.as_mut() {
             kkt.fill(&ws.mass_values, &ws.cq_values, &ws.g_values);
-            if kkt.factor().is_ok() {
+            let ldlt = self.ldlt.as_mut().is_some_and(|f| {
+                f.factor(&ws.mass_values, &ws.cq_values, &ws.g_values) && {
+                    self.x.copy_from_slice(&self.b);
+                    f.solve_in_place(&mut self.x, &ws.cq_values);
+                    let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);
+                    res <= self.params.residual_tolerance * scale
+                }
+            });
+            if ldlt {
+                Some(AccelerationStats {
+                    path: SolverPath::SparseLdlt,
+                    rank: m,
+                    pivot_ratio: 1.0,
+                })
+            } else if kkt.factor().is_ok() {
                 self.x.copy_from_slice(&self.b);
                 kkt.solve_in_place(&mut self.x);
                 let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);

@@ -140,10 +140,12 @@ fn hot_paths_do_not_allocate_after_warm_up() {
     let q = sc.configuration(std::f64::consts::FRAC_PI_6);
     let qd = [0.1; 9];
     accelerations_do_not_allocate(&sc, &q, &qd, LinearSolver::Dense, SolverPath::Dense);
-    accelerations_do_not_allocate(&sc, &q, &qd, LinearSolver::Sparse, SolverPath::Sparse);
+    accelerations_do_not_allocate(&sc, &q, &qd, LinearSolver::Sparse, SolverPath::SparseLdlt);
+    accelerations_do_not_allocate(&sc, &q, &qd, LinearSolver::SparseLu, SolverPath::Sparse);
     let chain = Chain::new(40);
     let (q, qd) = chain.state();
-    accelerations_do_not_allocate(&chain, &q, &qd, LinearSolver::Auto, SolverPath::Sparse);
+    accelerations_do_not_allocate(&chain, &q, &qd, LinearSolver::Auto, SolverPath::SparseLdlt);
+    accelerations_do_not_allocate(&chain, &q, &qd, LinearSolver::SparseLu, SolverPath::Sparse);
     accelerations_do_not_allocate(&chain, &q, &qd, LinearSolver::Dense, SolverPath::Dense);
 
     // K1 and K2 on the free slider-crank, with an existing partition.

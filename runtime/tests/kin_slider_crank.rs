@@ -142,7 +142,8 @@ fn v10_driven_velocities_and_accelerations() {
     let (mut qdd, mut lambda) = ([0.0; 9], [0.0; 9]);
     for (solver, path) in [
         (LinearSolver::Dense, SolverPath::Dense),
-        (LinearSolver::Sparse, SolverPath::Sparse),
+        (LinearSolver::SparseLu, SolverPath::Sparse),
+        (LinearSolver::Sparse, SolverPath::SparseLdlt),
     ] {
         let params = DynamicsParams {
             solver,

@@ -190,7 +190,7 @@ fn rhs(c: &mut Criterion) {
         let general = if dim < DEFAULT_CROSSOVER {
             LinearSolver::Dense
         } else {
-            LinearSolver::Sparse
+            LinearSolver::SparseLu
         };
         for (form, solver) in Formulation::ALL
             .into_iter()

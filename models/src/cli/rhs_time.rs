@@ -52,6 +52,7 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
         SolverPath::Generated => "generated",
         SolverPath::Dense => "dense",
         SolverPath::Sparse => "sparse",
+        SolverPath::SparseLdlt => "sparse LDLT",
         SolverPath::Redundant => "redundant",
     };
     if args.json {

@@ -12,12 +12,19 @@
 //! allocates as long as the fill stays the same.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
+};
 use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::{LuError, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par};
+use faer::{Conj, MatMut, Par, Side};
 
 use crate::Info;
 
@@ -200,5 +207,351 @@ impl SparseKkt {
         }
         let scale = kmax * super::inf_norm(x) + super::inf_norm(b);
         (super::inf_norm(r), scale)
+    }
+}
+
+/// The smallest accepted ratio of a pivot of [`SparseLdlt`] to the diagonal it started
+/// from (the generated solve's test, `pfaff_codegen::emit::solve::PIVOT_RATIO`).
+const PIVOT_RATIO: f64 = 1e-8;
+
+/// An entry of $\rho\, J_r^\mathsf{T} J_r$ added to $M$ (see [`SparseLdlt`]): the
+/// positions in the row's entries of its two factors and where it is added.
+#[derive(Clone, Copy, Debug)]
+struct Added {
+    a: usize,
+    b: usize,
+    at: usize,
+}
+
+/// A holonomic row added to $M$ in the augmented-Lagrangian way.
+#[derive(Clone, Debug)]
+struct AddedRow {
+    /// The row of $C_q$.
+    row: usize,
+    /// Its entries: `(column, index in the pattern of C_q)`.
+    entries: Vec<(usize, usize)>,
+    /// The products of its entries that land in the lower triangle of $M$.
+    products: Vec<Added>,
+    /// $\rho$ of the last fill.
+    rho: f64,
+}
+
+/// The sparse $LDL^\mathsf{T}$ of the augmented matrix without pivoting, in the
+/// generated solve's order: every coordinate before every multiplier, an approximate
+/// minimum degree order within each group.
+///
+/// Eliminating the coordinates first makes the first $n$ pivots those of $M$ (positive)
+/// and the last $m$ those of $-J M^{-1} J^\mathsf{T}$ (negative), so no pivoting is
+/// needed while $M$ is positive definite and $J$ has full rank; and since $M$ couples
+/// only the coordinates of one body, the Schur complement couples only the constraints
+/// that share a body: the factor stays as sparse as the mechanism's graph (a chain's is
+/// banded), where the general $LU$ with partial pivoting (COLAMD order, rows swapped
+/// by magnitude) fills more and spends its time on the pivot search.
+///
+/// A holonomic row whose columns form a block of $M$'s pattern (Euler parameters'
+/// normalization, along whose gradient $M$ is singular) is added to $M$ as
+/// $\tilde M = M + \rho J_r^\mathsf{T} J_r$, $\tilde Q = Q + \rho J_r^\mathsf{T}
+/// \gamma_r$, which changes neither the pattern nor the solution ($J_r \ddot q =
+/// \gamma_r$), with $\rho = \sum_c M_{cc} / \sum_c J_{rc}^2$ over the row's columns (no
+/// dependence on units), as the generated solve does.
+///
+/// Every pivot is checked, relative to the diagonal it started from: $d_k > \epsilon
+/// \tilde M_{kk}$ for a coordinate, $-d_k > \epsilon \sum_c J_{kc}^2 / \tilde M_{cc}$ for
+/// a multiplier ($\epsilon$ = [`PIVOT_RATIO`]; both invariant under a change of units).
+/// A failed pivot (redundant or nearly dependent constraints, a mass matrix singular
+/// off the constraints) hands the system to the $LU$.
+pub(crate) struct SparseLdlt {
+    n: usize,
+    dim: usize,
+    /// The lower triangle of $\tilde K$ in compressed columns (original numbering).
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    values: Vec<f64>,
+    /// Position of each entry of the pattern of $M$ in the lower triangle (`None`: an
+    /// upper entry).
+    mass_map: Vec<Option<usize>>,
+    /// Position of each entry of $C_q$ and $G$ (below the coordinates' block).
+    cq_map: Vec<usize>,
+    g_map: Vec<usize>,
+    /// Position of the diagonal entry of each coordinate.
+    diagonal: Vec<usize>,
+    added: Vec<AddedRow>,
+    /// Elimination position → node.
+    order: Vec<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    /// The pivot scale of each multiplier, $\sum_c J_{kc}^2 / \tilde M_{cc}$.
+    scale: Vec<f64>,
+    mem: MemBuffer,
+}
+
+impl std::fmt::Debug for SparseLdlt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SparseLdlt")
+            .field("dim", &self.dim)
+            .field("nnz_l", &self.l_values.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl SparseLdlt {
+    /// The structure, the order and the symbolic factorization from the patterns of
+    /// `info`; `None` when a coordinate has no diagonal mass entry (then $M$ is
+    /// singular for every value) or the symbolic factorization fails.
+    pub fn new(info: &Info) -> Option<Self> {
+        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        let dim = n + mh + mnh;
+        let mut entries: Vec<(usize, usize)> = Vec::new();
+        for &(r, c) in info.mass_pattern {
+            if r >= c {
+                entries.push((c as usize, r as usize));
+            }
+        }
+        for &(r, c) in info.holonomic_pattern {
+            entries.push((c as usize, n + r as usize));
+        }
+        for &(r, c) in info.nonholonomic_pattern {
+            entries.push((c as usize, n + mh + r as usize));
+        }
+        entries.sort_unstable();
+        entries.dedup();
+        let mut col_ptr = vec![0usize; dim + 1];
+        let mut row_idx = Vec::with_capacity(entries.len());
+        for &(c, r) in &entries {
+            col_ptr[c + 1] += 1;
+            row_idx.push(r);
+        }
+        for c in 0..dim {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let position = |r: usize, c: usize| -> Option<usize> {
+            let (lo, hi) = if r >= c { (c, r) } else { (r, c) };
+            let col = &row_idx[col_ptr[lo]..col_ptr[lo + 1]];
+            col.binary_search(&hi).ok().map(|k| col_ptr[lo] + k)
+        };
+        let mut diagonal = Vec::with_capacity(n);
+        for c in 0..n {
+            diagonal.push(position(c, c)?);
+        }
+        let mass_map = info
+            .mass_pattern
+            .iter()
+            .map(|&(r, c)| (r >= c).then(|| position(r as usize, c as usize)).flatten())
+            .collect();
+        let cq_map = info
+            .holonomic_pattern
+            .iter()
+            .map(|&(r, c)| position(n + r as usize, c as usize))
+            .collect::<Option<Vec<_>>>()?;
+        let g_map = info
+            .nonholonomic_pattern
+            .iter()
+            .map(|&(r, c)| position(n + mh + r as usize, c as usize))
+            .collect::<Option<Vec<_>>>()?;
+        // Rows whose columns are a block of M's pattern: ρ JᵣᵀJᵣ adds no entry.
+        let mut added = Vec::new();
+        for row in 0..mh {
+            let entries: Vec<(usize, usize)> = info
+                .holonomic_pattern
+                .iter()
+                .enumerate()
+                .filter(|(_, &(r, _))| r as usize == row)
+                .map(|(k, &(_, c))| (c as usize, k))
+                .collect();
+            let mut products = Vec::new();
+            let block = entries.iter().enumerate().all(|(a, &(ca, _))| {
+                entries.iter().enumerate().all(|(b, &(cb, _))| {
+                    if ca < cb {
+                        return true;
+                    }
+                    position(ca, cb).is_some_and(|at| {
+                        products.push(Added { a, b, at });
+                        true
+                    })
+                })
+            });
+            if block && entries.len() > 1 {
+                added.push(AddedRow {
+                    row,
+                    entries,
+                    products,
+                    rho: 0.0,
+                });
+            }
+        }
+        // An approximate minimum degree order of the whole pattern, then every
+        // coordinate before every multiplier (each group in that order).
+        let lower = SymbolicSparseColMatRef::new_checked(dim, dim, &col_ptr, None, &row_idx);
+        let mut fwd = vec![0usize; dim];
+        let mut inv = vec![0usize; dim];
+        {
+            // AMD reads the upper triangle: the same entries by rows.
+            let mut upper: Vec<(usize, usize)> = entries.iter().map(|&(c, r)| (r, c)).collect();
+            upper.sort_unstable();
+            let mut up_ptr = vec![0usize; dim + 1];
+            let up_idx: Vec<usize> = upper.iter().map(|&(_, r)| r).collect();
+            for &(c, _) in &upper {
+                up_ptr[c + 1] += 1;
+            }
+            for c in 0..dim {
+                up_ptr[c + 1] += up_ptr[c];
+            }
+            let nnz = up_idx.len();
+            let mut mem = MemBuffer::new(amd::order_scratch::<usize>(dim, nnz));
+            amd::order(
+                &mut fwd,
+                &mut inv,
+                SymbolicSparseColMatRef::new_checked(dim, dim, &up_ptr, None, &up_idx),
+                amd::Control::default(),
+                MemStack::new(&mut mem),
+            )
+            .ok()?;
+        }
+        let order: Vec<usize> = fwd
+            .iter()
+            .copied()
+            .filter(|&v| v < n)
+            .chain(fwd.iter().copied().filter(|&v| v >= n))
+            .collect();
+        for (p, &v) in order.iter().enumerate() {
+            inv[v] = p;
+        }
+        let symbolic = factorize_symbolic_cholesky(
+            lower,
+            Side::Lower,
+            SymmetricOrdering::Custom(PermRef::new_checked(&order, &inv, dim)),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+                ..Default::default()
+            },
+        )
+        .ok()?;
+        // The simplicial factor stores each column's diagonal (D) first.
+        let SymbolicCholeskyRaw::Simplicial(s) = symbolic.raw() else {
+            return None;
+        };
+        let diagonal_first = (0..dim).all(|j| s.row_idx()[s.col_ptr()[j]] == j);
+        if !diagonal_first {
+            return None;
+        }
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        Some(Self {
+            n,
+            dim,
+            values: vec![0.0; row_idx.len()],
+            col_ptr,
+            row_idx,
+            mass_map,
+            cq_map,
+            g_map,
+            diagonal,
+            added,
+            order,
+            l_values: vec![0.0; symbolic.len_val()],
+            symbolic,
+            scale: vec![0.0; dim - n],
+            mem: MemBuffer::new(req),
+        })
+    }
+
+    /// Factors $\tilde K$ from the pattern values of $M$, $C_q$ and $G$; `false` when a
+    /// pivot fails its test (see the type's docs).
+    pub fn factor(&mut self, mass: &[f64], cq: &[f64], g: &[f64]) -> bool {
+        let n = self.n;
+        for (p, &v) in self.mass_map.iter().zip(mass) {
+            if let Some(p) = *p {
+                self.values[p] = v;
+            }
+        }
+        for (&p, &v) in self.cq_map.iter().zip(cq) {
+            self.values[p] = v;
+        }
+        for (&p, &v) in self.g_map.iter().zip(g) {
+            self.values[p] = v;
+        }
+        for row in &mut self.added {
+            let (mut trace, mut norm) = (0.0, 0.0);
+            for &(c, k) in &row.entries {
+                trace += self.values[self.diagonal[c]];
+                norm += cq[k] * cq[k];
+            }
+            row.rho = trace / norm;
+            if !(row.rho.is_finite() && row.rho > 0.0) {
+                return false;
+            }
+            for e in &row.products {
+                let (ja, jb) = (cq[row.entries[e.a].1], cq[row.entries[e.b].1]);
+                self.values[e.at] += row.rho * ja * jb;
+            }
+        }
+        // The multipliers' pivot scales Σ_c J_kc² / M̃_cc (one pass over J's entries,
+        // which are the entries below the coordinates' block).
+        self.scale.fill(0.0);
+        for c in 0..n {
+            let mcc = self.values[self.diagonal[c]];
+            for p in self.col_ptr[c]..self.col_ptr[c + 1] {
+                let r = self.row_idx[p];
+                if r >= n {
+                    self.scale[r - n] += self.values[p] * self.values[p] / mcc;
+                }
+            }
+        }
+        let a = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(
+                self.dim,
+                self.dim,
+                &self.col_ptr,
+                None,
+                &self.row_idx,
+            ),
+            &self.values,
+        );
+        let factored = self.symbolic.factorize_numeric_ldlt(
+            &mut self.l_values,
+            a,
+            Side::Lower,
+            LdltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
+        if factored.is_err() {
+            return false;
+        }
+        let SymbolicCholeskyRaw::Simplicial(s) = self.symbolic.raw() else {
+            return false;
+        };
+        let col_ptr = s.col_ptr();
+        self.order.iter().enumerate().all(|(k, &v)| {
+            let d = self.l_values[col_ptr[k]];
+            if v < n {
+                d > PIVOT_RATIO * self.values[self.diagonal[v]]
+            } else {
+                -d > PIVOT_RATIO * self.scale[v - n]
+            }
+        })
+    }
+
+    /// Solves $K x = b$ in place with the last factorization: `b` holds $[Q; \gamma]$
+    /// (the system's own right-hand side; the terms of the rows added to $M$ are added
+    /// here) and $[\ddot q; \lambda]$ on return.
+    pub fn solve_in_place(&mut self, b: &mut [f64], cq: &[f64]) {
+        let n = self.n;
+        for row in &self.added {
+            let gamma = b[n + row.row];
+            for &(c, k) in &row.entries {
+                b[c] += row.rho * cq[k] * gamma;
+            }
+        }
+        let lu = LdltRef::new(&self.symbolic, &self.l_values);
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(b, self.dim, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
     }
 }
