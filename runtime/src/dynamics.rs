@@ -11,9 +11,11 @@
 //! **Paths.** The model's own solve ([`Mechanism::augmented_solve`]: a sparse
 //! $LDL^\mathsf{T}$ the generator specialized to the patterns of $M$ and $J$, every
 //! pivot checked) when it has one and its pivots are safe; otherwise a dense $LU$ for
-//! small systems, a sparse $LU$ (symbolic factorization once from the patterns,
-//! numeric each call) for large ones; [`LinearSolver::Auto`] takes the model's solve
-//! first and switches from dense to sparse at [`DynamicsParams::crossover`] unknowns.
+//! small systems, and for large ones a sparse $LDL^\mathsf{T}$ in the generated solve's
+//! order (coordinates first, no pivoting, every pivot checked; the symbolic
+//! factorization once from the patterns) with a sparse $LU$ (partial pivoting) behind
+//! it when a pivot fails; [`LinearSolver::Auto`] takes the model's solve first and
+//! switches from dense to sparse at [`DynamicsParams::crossover`] unknowns.
 //!
 //! **Redundant constraints.** When the dense pivots (ratio below
 //! [`DynamicsParams::rank_tolerance`]) or the sparse residual reveal a singular
