@@ -588,13 +588,12 @@ impl Dynamics {
                 None
             }
         } else if let Some(kkt) = self.sparse.as_mut() {
-            kkt.fill(&ws.mass_values, &ws.cq_values, &ws.g_values);
+            // The LDLᵀ's pivot tests vouch for its solution as the generated solve's do;
+            // the LU's solution is checked by its residual.
             let ldlt = self.ldlt.as_mut().is_some_and(|f| {
                 f.factor(&ws.mass_values, &ws.cq_values, &ws.g_values) && {
-                    self.x.copy_from_slice(&self.b);
-                    f.solve_in_place(&mut self.x, &ws.cq_values);
-                    let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);
-                    res <= self.params.residual_tolerance * scale
+                    f.solve(&self.b, &ws.cq_values, &mut self.x);
+                    true
                 }
             });
             if ldlt {
@@ -603,7 +602,10 @@ impl Dynamics {
                     rank: m,
                     pivot_ratio: 1.0,
                 })
-            } else if kkt.factor().is_ok() {
+            } else if {
+                kkt.fill(&ws.mass_values, &ws.cq_values, &ws.g_values);
+                kkt.factor().is_ok()
+            } {
                 self.x.copy_from_slice(&self.b);
                 kkt.solve_in_place(&mut self.x);
                 let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);

@@ -13,7 +13,6 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
@@ -263,25 +262,33 @@ struct AddedRow {
 pub(crate) struct SparseLdlt {
     n: usize,
     dim: usize,
-    /// The lower triangle of $\tilde K$ in compressed columns (original numbering).
+    /// The upper triangle of $\tilde K$ in compressed columns, rows and columns already
+    /// in elimination order (so that neither the factorization nor the solve permutes
+    /// or transposes anything per call).
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     values: Vec<f64>,
-    /// Position of each entry of the pattern of $M$ in the lower triangle (`None`: an
-    /// upper entry).
+    /// Position of each entry of the pattern of $M$ (`None`: the mirror of a stored
+    /// entry).
     mass_map: Vec<Option<usize>>,
-    /// Position of each entry of $C_q$ and $G$ (below the coordinates' block).
+    /// Position of each entry of $C_q$ and $G$.
     cq_map: Vec<usize>,
     g_map: Vec<usize>,
+    /// `(row, column)` of each entry of $C_q$ and $G$, rows of $G$ after those of $C_q$.
+    j_entries: Vec<(usize, usize)>,
     /// Position of the diagonal entry of each coordinate.
     diagonal: Vec<usize>,
     added: Vec<AddedRow>,
     /// Elimination position → node.
     order: Vec<usize>,
+    /// Node → elimination position.
+    position: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     /// The pivot scale of each multiplier, $\sum_c J_{kc}^2 / \tilde M_{cc}$.
     scale: Vec<f64>,
+    /// The right-hand side in elimination order.
+    permuted: Vec<f64>,
     mem: MemBuffer,
 }
 
@@ -294,6 +301,29 @@ impl std::fmt::Debug for SparseLdlt {
     }
 }
 
+/// Compressed columns of the entries `(column, row)` (sorted and deduplicated here)
+/// and the position of an entry in them.
+fn compressed(mut entries: Vec<(usize, usize)>, dim: usize) -> (Vec<usize>, Vec<usize>) {
+    entries.sort_unstable();
+    entries.dedup();
+    let mut col_ptr = vec![0usize; dim + 1];
+    let mut row_idx = Vec::with_capacity(entries.len());
+    for &(c, r) in &entries {
+        col_ptr[c + 1] += 1;
+        row_idx.push(r);
+    }
+    for c in 0..dim {
+        col_ptr[c + 1] += col_ptr[c];
+    }
+    (col_ptr, row_idx)
+}
+
+/// The position of entry `(row, col)` in compressed columns, if stored.
+fn find(col_ptr: &[usize], row_idx: &[usize], row: usize, col: usize) -> Option<usize> {
+    let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+    column.binary_search(&row).ok().map(|k| col_ptr[col] + k)
+}
+
 impl SparseLdlt {
     /// The structure, the order and the symbolic factorization from the patterns of
     /// `info`; `None` when a coordinate has no diagonal mass entry (then $M$ is
@@ -301,53 +331,81 @@ impl SparseLdlt {
     pub fn new(info: &Info) -> Option<Self> {
         let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
         let dim = n + mh + mnh;
-        let mut entries: Vec<(usize, usize)> = Vec::new();
-        for &(r, c) in info.mass_pattern {
-            if r >= c {
-                entries.push((c as usize, r as usize));
-            }
+        // Every entry of K̃ as (node, node), M's and J's, in the original numbering.
+        let j_entries: Vec<(usize, usize)> = info
+            .holonomic_pattern
+            .iter()
+            .map(|&(r, c)| (r as usize, c as usize))
+            .chain(
+                info.nonholonomic_pattern
+                    .iter()
+                    .map(|&(r, c)| (mh + r as usize, c as usize)),
+            )
+            .collect();
+        let pairs: Vec<(usize, usize)> = info
+            .mass_pattern
+            .iter()
+            .map(|&(r, c)| (r as usize, c as usize))
+            .chain(j_entries.iter().map(|&(r, c)| (n + r, c)))
+            .collect();
+        // An approximate minimum degree order of the whole pattern (AMD reads the upper
+        // triangle), then every coordinate before every multiplier, each group in that
+        // order.
+        let (up_ptr, up_idx) = compressed(
+            pairs.iter().map(|&(a, b)| (a.max(b), a.min(b))).collect(),
+            dim,
+        );
+        let mut fwd = vec![0usize; dim];
+        let mut inv = vec![0usize; dim];
+        {
+            let mut mem = MemBuffer::new(amd::order_scratch::<usize>(dim, up_idx.len()));
+            amd::order(
+                &mut fwd,
+                &mut inv,
+                SymbolicSparseColMatRef::new_checked(dim, dim, &up_ptr, None, &up_idx),
+                amd::Control::default(),
+                MemStack::new(&mut mem),
+            )
+            .ok()?;
         }
-        for &(r, c) in info.holonomic_pattern {
-            entries.push((c as usize, n + r as usize));
+        let order: Vec<usize> = fwd
+            .iter()
+            .copied()
+            .filter(|&v| v < n)
+            .chain(fwd.iter().copied().filter(|&v| v >= n))
+            .collect();
+        for (p, &v) in order.iter().enumerate() {
+            inv[v] = p;
         }
-        for &(r, c) in info.nonholonomic_pattern {
-            entries.push((c as usize, n + mh + r as usize));
-        }
-        entries.sort_unstable();
-        entries.dedup();
-        let mut col_ptr = vec![0usize; dim + 1];
-        let mut row_idx = Vec::with_capacity(entries.len());
-        for &(c, r) in &entries {
-            col_ptr[c + 1] += 1;
-            row_idx.push(r);
-        }
-        for c in 0..dim {
-            col_ptr[c + 1] += col_ptr[c];
-        }
-        let position = |r: usize, c: usize| -> Option<usize> {
-            let (lo, hi) = if r >= c { (c, r) } else { (r, c) };
-            let col = &row_idx[col_ptr[lo]..col_ptr[lo + 1]];
-            col.binary_search(&hi).ok().map(|k| col_ptr[lo] + k)
+        // The upper triangle in elimination order: (column, row) = (max, min) of the
+        // positions.
+        let at = |a: usize, b: usize| {
+            let (pa, pb) = (inv[a], inv[b]);
+            (pa.max(pb), pa.min(pb))
+        };
+        let (col_ptr, row_idx) = compressed(pairs.iter().map(|&(a, b)| at(a, b)).collect(), dim);
+        let position = |a: usize, b: usize| {
+            let (c, r) = at(a, b);
+            find(&col_ptr, &row_idx, r, c)
         };
         let mut diagonal = Vec::with_capacity(n);
         for c in 0..n {
             diagonal.push(position(c, c)?);
         }
+        // One of each mirror pair of M writes the stored entry.
         let mass_map = info
             .mass_pattern
             .iter()
             .map(|&(r, c)| (r >= c).then(|| position(r as usize, c as usize)).flatten())
             .collect();
-        let cq_map = info
-            .holonomic_pattern
+        let j_map = j_entries
             .iter()
-            .map(|&(r, c)| position(n + r as usize, c as usize))
+            .map(|&(r, c)| position(n + r, c))
             .collect::<Option<Vec<_>>>()?;
-        let g_map = info
-            .nonholonomic_pattern
-            .iter()
-            .map(|&(r, c)| position(n + mh + r as usize, c as usize))
-            .collect::<Option<Vec<_>>>()?;
+        let (cq_map, g_map) = (
+            j_map[..info.holonomic_pattern.len()].to_vec(),
+            j_map[info.holonomic_pattern.len()..].to_vec(),
+        );
         // Rows whose columns are a block of M's pattern: ρ JᵣᵀJᵣ adds no entry.
         let mut added = Vec::new();
         for row in 0..mh {
@@ -379,47 +437,10 @@ impl SparseLdlt {
                 });
             }
         }
-        // An approximate minimum degree order of the whole pattern, then every
-        // coordinate before every multiplier (each group in that order).
-        let lower = SymbolicSparseColMatRef::new_checked(dim, dim, &col_ptr, None, &row_idx);
-        let mut fwd = vec![0usize; dim];
-        let mut inv = vec![0usize; dim];
-        {
-            // AMD reads the upper triangle: the same entries by rows.
-            let mut upper: Vec<(usize, usize)> = entries.iter().map(|&(c, r)| (r, c)).collect();
-            upper.sort_unstable();
-            let mut up_ptr = vec![0usize; dim + 1];
-            let up_idx: Vec<usize> = upper.iter().map(|&(_, r)| r).collect();
-            for &(c, _) in &upper {
-                up_ptr[c + 1] += 1;
-            }
-            for c in 0..dim {
-                up_ptr[c + 1] += up_ptr[c];
-            }
-            let nnz = up_idx.len();
-            let mut mem = MemBuffer::new(amd::order_scratch::<usize>(dim, nnz));
-            amd::order(
-                &mut fwd,
-                &mut inv,
-                SymbolicSparseColMatRef::new_checked(dim, dim, &up_ptr, None, &up_idx),
-                amd::Control::default(),
-                MemStack::new(&mut mem),
-            )
-            .ok()?;
-        }
-        let order: Vec<usize> = fwd
-            .iter()
-            .copied()
-            .filter(|&v| v < n)
-            .chain(fwd.iter().copied().filter(|&v| v >= n))
-            .collect();
-        for (p, &v) in order.iter().enumerate() {
-            inv[v] = p;
-        }
         let symbolic = factorize_symbolic_cholesky(
-            lower,
-            Side::Lower,
-            SymmetricOrdering::Custom(PermRef::new_checked(&order, &inv, dim)),
+            SymbolicSparseColMatRef::new_checked(dim, dim, &col_ptr, None, &row_idx),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
                 ..Default::default()
@@ -430,8 +451,7 @@ impl SparseLdlt {
         let SymbolicCholeskyRaw::Simplicial(s) = symbolic.raw() else {
             return None;
         };
-        let diagonal_first = (0..dim).all(|j| s.row_idx()[s.col_ptr()[j]] == j);
-        if !diagonal_first {
+        if !(0..dim).all(|j| s.row_idx()[s.col_ptr()[j]] == j) {
             return None;
         }
         let req = StackReq::any_of(&[
@@ -447,12 +467,15 @@ impl SparseLdlt {
             mass_map,
             cq_map,
             g_map,
+            j_entries,
             diagonal,
             added,
             order,
+            position: inv,
             l_values: vec![0.0; symbolic.len_val()],
             symbolic,
             scale: vec![0.0; dim - n],
+            permuted: vec![0.0; dim],
             mem: MemBuffer::new(req),
         })
     }
@@ -460,7 +483,6 @@ impl SparseLdlt {
     /// Factors $\tilde K$ from the pattern values of $M$, $C_q$ and $G$; `false` when a
     /// pivot fails its test (see the type's docs).
     pub fn factor(&mut self, mass: &[f64], cq: &[f64], g: &[f64]) -> bool {
-        let n = self.n;
         for (p, &v) in self.mass_map.iter().zip(mass) {
             if let Some(p) = *p {
                 self.values[p] = v;
@@ -487,17 +509,10 @@ impl SparseLdlt {
                 self.values[e.at] += row.rho * ja * jb;
             }
         }
-        // The multipliers' pivot scales Σ_c J_kc² / M̃_cc (one pass over J's entries,
-        // which are the entries below the coordinates' block).
+        // The multipliers' pivot scales Σ_c J_kc² / M̃_cc.
         self.scale.fill(0.0);
-        for c in 0..n {
-            let mcc = self.values[self.diagonal[c]];
-            for p in self.col_ptr[c]..self.col_ptr[c + 1] {
-                let r = self.row_idx[p];
-                if r >= n {
-                    self.scale[r - n] += self.values[p] * self.values[p] / mcc;
-                }
-            }
+        for (&(r, c), &v) in self.j_entries.iter().zip(cq.iter().chain(g)) {
+            self.scale[r] += v * v / self.values[self.diagonal[c]];
         }
         let a = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(
@@ -512,7 +527,7 @@ impl SparseLdlt {
         let factored = self.symbolic.factorize_numeric_ldlt(
             &mut self.l_values,
             a,
-            Side::Lower,
+            Side::Upper,
             LdltRegularization::default(),
             Par::Seq,
             MemStack::new(&mut self.mem),
@@ -524,7 +539,7 @@ impl SparseLdlt {
         let SymbolicCholeskyRaw::Simplicial(s) = self.symbolic.raw() else {
             return false;
         };
-        let col_ptr = s.col_ptr();
+        let (n, col_ptr) = (self.n, s.col_ptr());
         self.order.iter().enumerate().all(|(k, &v)| {
             let d = self.l_values[col_ptr[k]];
             if v < n {
@@ -535,23 +550,29 @@ impl SparseLdlt {
         })
     }
 
-    /// Solves $K x = b$ in place with the last factorization: `b` holds $[Q; \gamma]$
-    /// (the system's own right-hand side; the terms of the rows added to $M$ are added
-    /// here) and $[\ddot q; \lambda]$ on return.
-    pub fn solve_in_place(&mut self, b: &mut [f64], cq: &[f64]) {
+    /// Solves $K x = b$ with the last factorization: `b` holds $[Q; \gamma]$ (the
+    /// system's own right-hand side; the terms of the rows added to $M$ are added
+    /// here), `x` receives $[\ddot q; \lambda]$.
+    pub fn solve(&mut self, b: &[f64], cq: &[f64], x: &mut [f64]) {
         let n = self.n;
+        for (p, &v) in self.permuted.iter_mut().zip(&self.order) {
+            *p = b[v];
+        }
         for row in &self.added {
             let gamma = b[n + row.row];
             for &(c, k) in &row.entries {
-                b[c] += row.rho * cq[k] * gamma;
+                self.permuted[self.position[c]] += row.rho * cq[k] * gamma;
             }
         }
         let lu = LdltRef::new(&self.symbolic, &self.l_values);
         lu.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(b, self.dim, 1),
+            MatMut::from_column_major_slice_mut(&mut self.permuted, self.dim, 1),
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
+        for (p, &v) in self.permuted.iter().zip(&self.order) {
+            x[v] = *p;
+        }
     }
 }
