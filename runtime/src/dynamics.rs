@@ -602,10 +602,11 @@ impl Dynamics {
                     rank: m,
                     pivot_ratio: 1.0,
                 })
-            } else if {
-                kkt.fill(&ws.mass_values, &ws.cq_values, &ws.g_values);
-                kkt.factor().is_ok()
-            } {
+            } else if kkt
+                .fill(&ws.mass_values, &ws.cq_values, &ws.g_values)
+                .factor()
+                .is_ok()
+            {
                 self.x.copy_from_slice(&self.b);
                 kkt.solve_in_place(&mut self.x);
                 let (res, scale) = kkt.residual(&self.x, &self.b, &mut self.r);

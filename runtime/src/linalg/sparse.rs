@@ -131,7 +131,7 @@ impl SparseKkt {
     }
 
     /// Writes the pattern values of $M$, $C_q$ and $G$ into $K$.
-    pub fn fill(&mut self, mass: &[f64], cq: &[f64], g: &[f64]) {
+    pub fn fill(&mut self, mass: &[f64], cq: &[f64], g: &[f64]) -> &mut Self {
         for (&p, &v) in self.mass_map.iter().zip(mass) {
             self.values[p] = v;
         }
@@ -143,6 +143,7 @@ impl SparseKkt {
             self.values[p[0]] = v;
             self.values[p[1]] = v;
         }
+        self
     }
 
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
