@@ -487,6 +487,47 @@ impl Dynamics {
         self.generated && self.split.is_none()
     }
 
+    /// Whether [`solve_unchecked`](Self::solve_unchecked) can serve: the model's
+    /// generated solve, or the sparse $LDL^\mathsf{T}$ when the model has none, and no
+    /// split of redundant rows in use.
+    pub(crate) fn solves_without_pivoting(&self) -> bool {
+        self.split.is_none() && (self.generated || self.ldlt.is_some())
+    }
+
+    /// Solves $[M\ J^\mathsf{T}; J\ 0]\,x = b$ in place (`x` holds $b$ on entry) from
+    /// the pattern values, by the model's generated solve or else the sparse
+    /// $LDL^\mathsf{T}$, both with their pivots checked; `false` when neither serves or
+    /// a pivot fails (`x` is then unspecified). For corrections (the projection in the
+    /// metric of $M$), not for the accelerations of a run: no rank decision, no
+    /// residual.
+    pub(crate) fn solve_unchecked<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        (mass, cq, g): (&[f64], &[f64], &[f64]),
+        x: &mut [f64],
+    ) -> bool {
+        if self.split.is_some() {
+            return false;
+        }
+        if self.generated {
+            match mech.augmented_solve(mass, cq, g, x) {
+                AugmentedSolve::Solved => return true,
+                AugmentedSolve::Declined => return false,
+                // The model has none: not tried again, as in the accelerations.
+                AugmentedSolve::Unavailable => self.generated = false,
+            }
+        }
+        let Some(ldlt) = self.ldlt.as_mut() else {
+            return false;
+        };
+        if !ldlt.factor(mass, cq, g) {
+            return false;
+        }
+        self.b.copy_from_slice(x);
+        ldlt.solve(&self.b, cq, x);
+        true
+    }
+
     /// The solve of [`Dynamics::accelerations_shifted`] with $M$, $Q$, $C_q$, $G$ and
     /// $\gamma$ already evaluated in `ws` (lengths checked by the caller), into
     /// `out` $= [\ddot q; \lambda]$ (length $n + m$; its contents are unspecified

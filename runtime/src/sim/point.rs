@@ -866,7 +866,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     const MASS_UPDATES: usize = 3;
 
     /// The projection in the metric of $M$, by the model's generated solve of the
-    /// augmented system (E31) with the right-hand sides $[0; -C; 0]$ and
+    /// augmented system (E31), or the sparse $LDL^\mathsf{T}$ of large models without
+    /// one ([`Dynamics`]' general path, pivots checked alike), with the right-hand sides $[0; -C; 0]$ and
     /// $[0; -(J\dot q + [C_t; g])]$: positions by the Newton updates
     /// $\Delta q = -M^{-1}J^\mathsf{T}(J M^{-1} J^\mathsf{T})^{-1}[C; 0]$ with $M$ of the
     /// integrator's last evaluation (the state to project for DOP853, DOPRI5 and
@@ -876,14 +877,18 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// are met to the Newton tolerance; then the velocities by one update with $J$ at
     /// the corrected positions, which meets $J\dot q + [C_t; g] = 0$ to round-off. The
     /// velocity update is the change of least kinetic energy that meets the velocity
-    /// constraints. `false` when it does not apply (no generated solve, rows dropped
+    /// constraints. `false` when it does not apply (neither solve, rows dropped
     /// as redundant, a declined or non-finite solve) or the positions do not converge
     /// in [`MASS_UPDATES`](Self::MASS_UPDATES) updates, for the orthogonal projection
     /// to finish from where it stopped.
     fn project_in_mass_metric(&mut self, t: f64) -> Result<bool, SimErrorKind> {
         let info = self.info;
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
-        if m == 0 || self.rows.len() != m || self.rows_h != mh || !self.dynamics.generated_solve() {
+        if m == 0
+            || self.rows.len() != m
+            || self.rows_h != mh
+            || !self.dynamics.solves_without_pivoting()
+        {
             return Ok(false);
         }
         let eval = SimErrorKind::from_eval;
@@ -942,8 +947,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// One update of [`project_in_mass_metric`](Self::project_in_mass_metric): with the
-    /// constraint residuals $r$ in the rows of `solution_scratch`, the generated solve
-    /// of $[M\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; -r]$ (the terms held in the
+    /// constraint residuals $r$ in the rows of `solution_scratch`, the solve
+    /// ([`Dynamics::solve_unchecked`]) of $[M\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; -r]$ (the terms held in the
     /// workspace), and $\Delta$ added to the positions (`positions`) or to the
     /// velocities. `false`, with nothing changed, when the solve declines or its
     /// result is not finite.
@@ -955,10 +960,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             *r = -*r;
         }
         let ws = &self.ws;
-        let solved = self
-            .mech
-            .augmented_solve(&ws.mass_values, &ws.cq_values, &ws.g_values, x);
-        if solved != crate::AugmentedSolve::Solved || !all_finite(x) {
+        let terms = (&ws.mass_values[..], &ws.cq_values[..], &ws.g_values[..]);
+        if !self.dynamics.solve_unchecked(self.mech, terms, x) || !all_finite(x) {
             return false;
         }
         self.factorizations += 1;
