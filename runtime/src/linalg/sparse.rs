@@ -330,21 +330,34 @@ impl SparseLdlt {
     /// `info`; `None` when a coordinate has no diagonal mass entry (then $M$ is
     /// singular for every value) or the symbolic factorization fails.
     pub fn new(info: &Info) -> Option<Self> {
-        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        Self::with_patterns(
+            info.nq(),
+            info.mass_pattern,
+            (info.holonomic_pattern, info.nh()),
+            (info.nonholonomic_pattern, info.nnh()),
+        )
+    }
+
+    /// [`new`](Self::new) for the patterns of $M$ (`n × n`), $C_q$ (`mh` rows) and $G$
+    /// (`mnh` rows) given apart from a model's [`Info`].
+    pub fn with_patterns(
+        n: usize,
+        mass_pattern: &[(u32, u32)],
+        (holonomic_pattern, mh): (&[(u32, u32)], usize),
+        (nonholonomic_pattern, mnh): (&[(u32, u32)], usize),
+    ) -> Option<Self> {
         let dim = n + mh + mnh;
         // Every entry of K̃ as (node, node), M's and J's, in the original numbering.
-        let j_entries: Vec<(usize, usize)> = info
-            .holonomic_pattern
+        let j_entries: Vec<(usize, usize)> = holonomic_pattern
             .iter()
             .map(|&(r, c)| (r as usize, c as usize))
             .chain(
-                info.nonholonomic_pattern
+                nonholonomic_pattern
                     .iter()
                     .map(|&(r, c)| (mh + r as usize, c as usize)),
             )
             .collect();
-        let pairs: Vec<(usize, usize)> = info
-            .mass_pattern
+        let pairs: Vec<(usize, usize)> = mass_pattern
             .iter()
             .map(|&(r, c)| (r as usize, c as usize))
             .chain(j_entries.iter().map(|&(r, c)| (n + r, c)))
@@ -394,8 +407,7 @@ impl SparseLdlt {
             diagonal.push(position(c, c)?);
         }
         // One of each mirror pair of M writes the stored entry.
-        let mass_map = info
-            .mass_pattern
+        let mass_map = mass_pattern
             .iter()
             .map(|&(r, c)| (r >= c).then(|| position(r as usize, c as usize)).flatten())
             .collect();
@@ -404,14 +416,13 @@ impl SparseLdlt {
             .map(|&(r, c)| position(n + r, c))
             .collect::<Option<Vec<_>>>()?;
         let (cq_map, g_map) = (
-            j_map[..info.holonomic_pattern.len()].to_vec(),
-            j_map[info.holonomic_pattern.len()..].to_vec(),
+            j_map[..holonomic_pattern.len()].to_vec(),
+            j_map[holonomic_pattern.len()..].to_vec(),
         );
         // Rows whose columns are a block of M's pattern: ρ JᵣᵀJᵣ adds no entry.
         let mut added = Vec::new();
         for row in 0..mh {
-            let entries: Vec<(usize, usize)> = info
-                .holonomic_pattern
+            let entries: Vec<(usize, usize)> = holonomic_pattern
                 .iter()
                 .enumerate()
                 .filter(|(_, &(r, _))| r as usize == row)
@@ -549,6 +560,26 @@ impl SparseLdlt {
                 -d > PIVOT_RATIO * self.scale[v - n]
             }
         })
+    }
+
+    /// The ratio of the smallest to the largest multiplier pivot of the last
+    /// factorization, each relative to its diagonal ($-d_k / \sum_c J_{kc}^2 / \tilde
+    /// M_{cc}$): with $M = I$ the pivot ratio of the equilibrated $J J^\mathsf{T}$.
+    pub fn schur_ratio(&self) -> f64 {
+        let SymbolicCholeskyRaw::Simplicial(s) = self.symbolic.raw() else {
+            return 0.0;
+        };
+        let (mut min, mut max) = (f64::INFINITY, 0.0_f64);
+        for (k, &v) in self.order.iter().enumerate().skip(self.n) {
+            let p = -self.l_values[s.col_ptr()[k]] / self.scale[v - self.n];
+            min = min.min(p);
+            max = max.max(p);
+        }
+        if max > 0.0 && min.is_finite() {
+            min / max
+        } else {
+            0.0
+        }
     }
 
     /// Solves $K x = b$ with the last factorization: `b` holds $[Q; \gamma]$ (the
