@@ -22,7 +22,7 @@ use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::{LuError, SupernodalThreshold};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 use crate::Info;
@@ -30,8 +30,8 @@ use crate::Info;
 /// Sparse augmented matrix with its symbolic and numeric $LU$.
 pub(crate) struct SparseKkt {
     dim: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    /// The structure of $K$ in compressed columns (checked once, here).
+    structure: SymbolicSparseColMat<usize>,
     values: Vec<f64>,
     mass_map: Vec<usize>,
     cq_map: Vec<[usize; 2]>,
@@ -45,17 +45,9 @@ impl std::fmt::Debug for SparseKkt {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SparseKkt")
             .field("dim", &self.dim)
-            .field("nnz", &self.row_idx.len())
+            .field("nnz", &self.values.len())
             .finish_non_exhaustive()
     }
-}
-
-/// Where a stored entry of $K$ takes its value from.
-#[derive(Clone, Copy)]
-enum Source {
-    Mass(usize),
-    Cq(usize, usize),
-    G(usize, usize),
 }
 
 impl SparseKkt {
@@ -64,41 +56,36 @@ impl SparseKkt {
         let n = info.nq();
         let mh = info.nh();
         let dim = n + mh + info.nnh();
-        // (column, row, source): sorting gives the compressed-column order.
-        let mut entries: Vec<(usize, usize, Source)> = Vec::new();
-        for (k, &(r, c)) in info.mass_pattern.iter().enumerate() {
-            entries.push((c as usize, r as usize, Source::Mass(k)));
-        }
-        for (k, &(r, c)) in info.holonomic_pattern.iter().enumerate() {
-            let (r, c) = (r as usize, c as usize);
-            entries.push((c, n + r, Source::Cq(k, 0)));
-            entries.push((n + r, c, Source::Cq(k, 1)));
-        }
-        for (k, &(r, c)) in info.nonholonomic_pattern.iter().enumerate() {
-            let (r, c) = (r as usize, c as usize);
-            entries.push((c, n + mh + r, Source::G(k, 0)));
-            entries.push((n + mh + r, c, Source::G(k, 1)));
-        }
-        entries.sort_by_key(|e| (e.0, e.1));
-        let mut col_ptr = vec![0usize; dim + 1];
-        let mut row_idx = Vec::with_capacity(entries.len());
-        let mut mass_map = vec![0; info.mass_pattern.len()];
-        let mut cq_map = vec![[0; 2]; info.holonomic_pattern.len()];
-        let mut g_map = vec![[0; 2]; info.nonholonomic_pattern.len()];
-        for (pos, &(c, r, src)) in entries.iter().enumerate() {
-            col_ptr[c + 1] += 1;
-            row_idx.push(r);
-            match src {
-                Source::Mass(k) => mass_map[k] = pos,
-                Source::Cq(k, s) => cq_map[k][s] = pos,
-                Source::G(k, s) => g_map[k][s] = pos,
-            }
-        }
-        for c in 0..dim {
-            col_ptr[c + 1] += col_ptr[c];
-        }
+        // (column, row) of every entry: M's, and J's in both of its blocks.
+        let j: Vec<(usize, usize)> = info
+            .holonomic_pattern
+            .iter()
+            .map(|&(r, c)| (n + r as usize, c as usize))
+            .chain(
+                info.nonholonomic_pattern
+                    .iter()
+                    .map(|&(r, c)| (n + mh + r as usize, c as usize)),
+            )
+            .collect();
+        let entries = info
+            .mass_pattern
+            .iter()
+            .map(|&(r, c)| (c as usize, r as usize))
+            .chain(j.iter().flat_map(|&(r, c)| [(c, r), (r, c)]))
+            .collect();
+        let (col_ptr, row_idx) = compressed(entries, dim);
+        let at = |r: usize, c: usize| find(&col_ptr, &row_idx, r, c).expect("a stored entry");
+        let mass_map = info
+            .mass_pattern
+            .iter()
+            .map(|&(r, c)| at(r as usize, c as usize))
+            .collect();
+        let mut j_map = j.iter().map(|&(r, c)| [at(c, r), at(r, c)]);
+        let cq_map = j_map.by_ref().take(info.holonomic_pattern.len()).collect();
+        let g_map = j_map.collect();
+        let structure = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
         let symbolic = factorize_symbolic_lu(
-            SymbolicSparseColMatRef::new_checked(dim, dim, &col_ptr, None, &row_idx),
+            structure.as_ref(),
             LuSymbolicParams {
                 // The augmented matrices of mechanisms are very sparse (banded for
                 // chains); supernodes buy nothing and their numeric phase allocates.
@@ -113,9 +100,8 @@ impl SparseKkt {
         ]);
         Ok(Self {
             dim,
-            values: vec![0.0; row_idx.len()],
-            col_ptr,
-            row_idx,
+            values: vec![0.0; structure.row_idx().len()],
+            structure,
             mass_map,
             cq_map,
             g_map,
@@ -127,7 +113,7 @@ impl SparseKkt {
 
     /// Stored entries of $K$.
     pub fn nnz(&self) -> usize {
-        self.row_idx.len()
+        self.values.len()
     }
 
     /// Writes the pattern values of $M$, $C_q$ and $G$ into $K$.
@@ -147,30 +133,12 @@ impl SparseKkt {
     }
 
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
-        SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(
-                self.dim,
-                self.dim,
-                &self.col_ptr,
-                None,
-                &self.row_idx,
-            ),
-            &self.values,
-        )
+        SparseColMatRef::new(self.structure.as_ref(), &self.values)
     }
 
     /// Numeric factorization of the current values.
     pub fn factor(&mut self) -> Result<(), LuError> {
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(
-                self.dim,
-                self.dim,
-                &self.col_ptr,
-                None,
-                &self.row_idx,
-            ),
-            &self.values,
-        );
+        let a = SparseColMatRef::new(self.structure.as_ref(), &self.values);
         self.symbolic
             .factorize_numeric_lu(
                 &mut self.numeric,
@@ -265,9 +233,8 @@ pub(crate) struct SparseLdlt {
     dim: usize,
     /// The upper triangle of $\tilde K$ in compressed columns, rows and columns already
     /// in elimination order (so that neither the factorization nor the solve permutes
-    /// or transposes anything per call).
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    /// or transposes anything per call), checked once.
+    structure: SymbolicSparseColMat<usize>,
     values: Vec<f64>,
     /// Position of each entry of the pattern of $M$ (`None`: the mirror of a stored
     /// entry).
@@ -449,8 +416,9 @@ impl SparseLdlt {
                 });
             }
         }
+        let structure = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
         let symbolic = factorize_symbolic_cholesky(
-            SymbolicSparseColMatRef::new_checked(dim, dim, &col_ptr, None, &row_idx),
+            structure.as_ref(),
             Side::Upper,
             SymmetricOrdering::Identity,
             CholeskySymbolicParams {
@@ -473,9 +441,8 @@ impl SparseLdlt {
         Some(Self {
             n,
             dim,
-            values: vec![0.0; row_idx.len()],
-            col_ptr,
-            row_idx,
+            values: vec![0.0; structure.row_idx().len()],
+            structure,
             mass_map,
             cq_map,
             g_map,
@@ -526,16 +493,7 @@ impl SparseLdlt {
         for (&(r, c), &v) in self.j_entries.iter().zip(cq.iter().chain(g)) {
             self.scale[r] += v * v / self.values[self.diagonal[c]];
         }
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(
-                self.dim,
-                self.dim,
-                &self.col_ptr,
-                None,
-                &self.row_idx,
-            ),
-            &self.values,
-        );
+        let a = SparseColMatRef::new(self.structure.as_ref(), &self.values);
         let factored = self.symbolic.factorize_numeric_ldlt(
             &mut self.l_values,
             a,

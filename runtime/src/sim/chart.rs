@@ -96,7 +96,8 @@ impl From<EvalError> for ChartFailure {
 struct Maps {
     /// The anchor $q_a$.
     anchor: Vec<f64>,
-    /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows[..rows_h]`.
+    /// $J(q_a)$, dense row-major `m × n`; $N$ is its rows `rows[..rows_h]` (not made
+    /// when the sparse factor serves the anchor).
     normals: Vec<f64>,
     /// $(N N^\mathsf{T})^{-1}N$, row-major `r × n` (its transpose is the map $P$).
     position_map: Vec<f64>,
@@ -177,15 +178,15 @@ impl Maps {
         }
     }
 
-    /// Makes the maps at the current positions of `p` (its dense $J$ there), with
-    /// `gram` as scratch; returns the pivot ratio of $N N^\mathsf{T}$.
+    /// Makes the maps at the current positions of `p` (its dense $J$ there, or only the
+    /// pattern values for the sparse factor), with `gram` as scratch; returns the pivot
+    /// ratio of $N N^\mathsf{T}$.
     fn make<M: Mechanism + ?Sized>(
         &mut self,
         gram: &mut SmallCholesky,
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<f64, EvalError> {
-        self.normals.copy_from_slice(p.dense_jacobian(t)?);
         self.anchor.copy_from_slice(&p.q);
         self.rows.clear();
         self.rows.extend_from_slice(&p.rows);
@@ -211,6 +212,7 @@ impl Maps {
                 self.sparse = Sparse::new(info);
             }
             if let Some(sp) = self.sparse.as_mut() {
+                p.jacobian_values(t)?;
                 if sp.ldlt.factor(&sp.ones, &p.ws.cq_values, &[]) {
                     let ratio = sp.ldlt.schur_ratio();
                     self.sparse_active = true;
@@ -220,6 +222,7 @@ impl Maps {
                 }
             }
         }
+        self.normals.copy_from_slice(p.dense_jacobian(t)?);
         // The Gram matrices from the products the patterns leave (the point's plans are
         // made for its rows, which the maps copied): the dense sums' bits.
         let (plan_h, plan_v) = p.gram_plans();

@@ -510,6 +510,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         }
     }
 
+    /// The pattern values of $C_q$ and $G$ at the current $(t, q)$, into the workspace
+    /// (`ws.cq_values`, `ws.g_values`), without the dense $J$.
+    pub fn jacobian_values(&mut self, t: f64) -> Result<(), EvalError> {
+        let at = self.position(t);
+        self.jacobian_values_at(t, at)
+    }
+
     /// The pattern values of $C_q$ and $G$ at the current $(t, q)$, of version `at`.
     fn jacobian_values_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         self.note_jacobian(at);
