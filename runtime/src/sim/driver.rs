@@ -154,8 +154,19 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             return;
         }
         self.y.copy_from_slice(stepper.y());
-        if self.sys.keep(t, self.y).is_ok() && self.record(t).is_err() {
-            self.record_state(t);
+        match self.sys.keep(t, self.y) {
+            Ok(_) => {
+                if self.record(t).is_err() {
+                    self.record_state(t);
+                }
+            }
+            // The state cannot be corrected (projection at a singular configuration):
+            // recorded as the integrator holds it, without accelerations, so that the
+            // run still ends where it stopped.
+            Err(_) => {
+                self.sys.point.set_state(self.y);
+                self.record_state(t);
+            }
         }
     }
 
