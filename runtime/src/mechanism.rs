@@ -358,12 +358,13 @@ pub struct DynamicsTerms<'a> {
     pub nonholonomic_gamma: &'a mut [f64],
 }
 
-/// The outcome of [`Mechanism::augmented_solve`].
+/// The outcome of [`Mechanism::augmented_solve`] and [`Mechanism::orthogonal_solve`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AugmentedSolve {
     /// The model has no specialized solve (the default).
     Unavailable,
-    /// Solved: the buffer holds $[\ddot q; \lambda]$.
+    /// Solved: the buffer holds the solution ($[\ddot q; \lambda]$ for
+    /// [`Mechanism::augmented_solve`]).
     Solved,
     /// A pivot was not safely positive (a mass matrix singular off the constraints,
     /// redundant or nearly dependent constraints, a singular configuration): the buffer
@@ -568,6 +569,25 @@ pub trait Mechanism {
         x: &mut [f64],
     ) -> AugmentedSolve {
         let _ = (mass, cq, g, x);
+        AugmentedSolve::Unavailable
+    }
+
+    /// Solves $[I\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; r]$, $J = [C_q; G]$, in
+    /// place: `x` (length `n + m_h + m_nh`) holds $r$ in its last `m_h + m_nh` entries
+    /// on entry (its first `n` are not read: the coordinates' block of the right-hand
+    /// side is zero), and $[\Delta; \mu]$ on return, from the pattern values `cq` and
+    /// `g`. $\Delta = J^\mathsf{T}(J J^\mathsf{T})^{-1} r$ is the least change with
+    /// $J\Delta = r$: with $r = -(J\dot q + [C_t; g])$, the orthogonal projection of
+    /// $\dot q$ onto the velocity constraints (coordinate partitioning projects the
+    /// velocities of every evaluation by it).
+    ///
+    /// The generator emits it like [`augmented_solve`](Self::augmented_solve) (the
+    /// same factorization with the identity in place of $M$, its pivots checked the
+    /// same way: dependent or nearly dependent rows return
+    /// [`AugmentedSolve::Declined`]). The default returns
+    /// [`AugmentedSolve::Unavailable`]. Allocates nothing.
+    fn orthogonal_solve(&self, cq: &[f64], g: &[f64], x: &mut [f64]) -> AugmentedSolve {
+        let _ = (cq, g, x);
         AugmentedSolve::Unavailable
     }
 

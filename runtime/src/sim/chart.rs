@@ -23,8 +23,14 @@
 //! integrators do), or at round-off. One update per evaluation is the norm.
 //!
 //! **Velocities** are projected orthogonally onto $J(q)\dot q + [C_t; g] = 0$ at the
-//! corrected positions (all rows, the non-holonomic ones too), as projection does, but
-//! without a factorization per evaluation: the chord iteration
+//! corrected positions (all rows, the non-holonomic ones too). Where the model has a
+//! generated [`Mechanism::orthogonal_solve`] (every built-in model with constraints),
+//! one call of it does this exactly: the system $[I\ J^\mathsf{T}; J\ 0]$ factored
+//! at the point by straight-line code specialized to the patterns, at the same cost
+//! whatever the distance from the anchor (ARCHITECTURE.md, "partitioning's
+//! velocities by a generated orthogonal solve"). Otherwise
+//! (no generated solve, or it declines: dependent or nearly dependent rows), the chord
+//! iteration
 //! $\dot q \leftarrow \dot q - J^\mathsf{T} G_a^{-1}(J\dot q + [C_t; g])$ with the inverse
 //! of the anchor's $G_a = J_a J_a^\mathsf{T}$ (made once per step) converges to the
 //! orthogonal projection at $q$ (every update lies in the range of $J(q)^\mathsf{T}$) at
@@ -46,7 +52,7 @@ use crate::linalg::small::{gram_cholesky_planned, SmallCholesky};
 use crate::linalg::sparse::SparseLdlt;
 use crate::scale;
 use crate::workspace::EvalError;
-use crate::{Info, Mechanism};
+use crate::{AugmentedSolve, Info, Mechanism};
 
 /// Fraction of the integrator's tolerance the Newton iteration leaves as error.
 ///
@@ -311,6 +317,11 @@ pub(crate) struct Chart {
     mu: Vec<f64>,
     /// The current position update.
     dx: Vec<f64>,
+    /// $[\Delta; \mu]$ of the model's generated orthogonal solve (`n + m`).
+    exact: Vec<f64>,
+    /// Whether the model's generated orthogonal solve is unavailable (learned at its
+    /// first call): the chord iteration projects every evaluation's velocities.
+    exact_unavailable: bool,
     /// The pattern of $J$ grouped by rows and by columns (made at the first velocity
     /// iteration).
     layout: Layout,
@@ -402,6 +413,8 @@ impl Chart {
             vel: vec![0.0; m],
             mu: vec![0.0; m],
             dx: vec![0.0; n],
+            exact: vec![0.0; n + m],
+            exact_unavailable: false,
             layout: Layout::default(),
             rate_per_distance: None,
             velocity_rate_per_distance: None,
@@ -623,6 +636,9 @@ impl Chart {
             bias: &ws.bias,
         };
         let distance = maps.distance(&p.q);
+        if self.exact_projection(p.mech, p.info, terms, &mut p.qd, staged) {
+            return Ok(Some(1));
+        }
         Ok(self.iterate_velocities(p.info, terms, distance, &mut p.qd, kappa, staged))
     }
 
@@ -640,18 +656,81 @@ impl Chart {
         self.maps.distance(q)
     }
 
-    /// The iteration of [`correct_velocities`](Self::correct_velocities) on `qd` at
-    /// positions `distance` from the anchor, with the pattern values of $C_q$, $G$ and
-    /// $C_t$, $g$ there.
-    pub fn project_velocities(
+    /// The orthogonal projection of `qd` onto the velocity constraints at a point with
+    /// the pattern values `terms`, in one pass by the model's generated
+    /// [`Mechanism::orthogonal_solve`] ($[I\ J^\mathsf{T}; J\ 0]$ factored at the
+    /// point, the right-hand side $[0; -(J\dot q + [C_t; g])]$), else by the
+    /// iteration of [`correct_velocities`](Self::correct_velocities) on `qd` at
+    /// positions `distance` from the anchor. The iteration's limit is the same
+    /// projection; the solve reaches it in one pass, where the iteration takes more
+    /// updates the further the point is from the anchor (1 to 5 at DOP853's stages).
+    /// The solve serves when every row is
+    /// projected (no redundant row dropped) and its pivots pass (it declines for
+    /// dependent or nearly dependent rows, which the iteration or the factored
+    /// projection then handle).
+    pub fn project_velocities<M: Mechanism + ?Sized>(
         &mut self,
+        mech: &M,
         info: &Info,
         terms: VelocityTerms<'_>,
         distance: f64,
         qd: &mut [f64],
         kappa: f64,
     ) -> Option<usize> {
+        if self.exact_projection(mech, info, terms, qd, false) {
+            return Some(1);
+        }
         self.iterate_velocities(info, terms, distance, qd, kappa, false)
+    }
+
+    /// Whether [`exact_projection`](Self::exact_projection) may serve the current (or
+    /// the staged) maps: the model's solve is not known to be unavailable and every
+    /// row is projected.
+    fn exact_ready(&self, staged: bool) -> bool {
+        let maps = if staged { &self.staged } else { &self.maps };
+        !self.exact_unavailable && maps.all_rows && !maps.rows.is_empty()
+    }
+
+    /// The one-pass projection of [`project_velocities`](Self::project_velocities)
+    /// for the maps of the current (or the staged) anchor; `false` when it does not
+    /// apply, `qd` unchanged.
+    fn exact_projection<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        info: &Info,
+        terms: VelocityTerms<'_>,
+        qd: &mut [f64],
+        staged: bool,
+    ) -> bool {
+        if !self.exact_ready(staged) {
+            return false;
+        }
+        if !self.layout.built {
+            self.layout = Layout::new(info, qd.len(), self.vel.len());
+        }
+        let n = qd.len();
+        self.layout.residuals(terms, qd, &mut self.vel);
+        for (r, v) in self.exact[n..].iter_mut().zip(&self.vel) {
+            *r = -v;
+        }
+        match mech.orthogonal_solve(terms.cq, terms.g, &mut self.exact) {
+            AugmentedSolve::Solved => {}
+            AugmentedSolve::Unavailable => {
+                self.exact_unavailable = true;
+                return false;
+            }
+            AugmentedSolve::Declined => return false,
+        }
+        let delta = &self.exact[..n];
+        // A non-finite input leaves a non-finite entry (as in the augmented solve):
+        // the iteration then reports it.
+        if !delta.iter().all(|d| d.is_finite()) {
+            return false;
+        }
+        for (x, d) in qd.iter_mut().zip(delta) {
+            *x += d;
+        }
+        true
     }
 
     fn iterate_velocities(

@@ -283,12 +283,12 @@ impl Form for Partitioned {
     ) -> Result<(), SimErrorKind> {
         if self.pending {
             self.pending = false;
-            let (info, distance) = (p.info, self.chart.distance(&p.q));
+            let (mech, info, distance) = (p.mech, p.info, self.chart.distance(&p.q));
             let chart = &mut self.chart;
             let mut outcome = None;
             p.dynamics_terms_corrected(t, &mut |cq, g, ct, bias, qd| {
                 let terms = VelocityTerms { cq, g, ct, bias };
-                outcome = chart.project_velocities(info, terms, distance, qd, KAPPA);
+                outcome = chart.project_velocities(mech, info, terms, distance, qd, KAPPA);
             })
             .map_err(SimErrorKind::from_eval)?;
             if outcome.is_none() {

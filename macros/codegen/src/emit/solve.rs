@@ -50,6 +50,8 @@ pub const PIVOT_RATIO: f64 = 1e-8;
 #[derive(Clone, Copy, Debug)]
 enum Source {
     Mass(usize),
+    /// A diagonal entry 1 (the identity metric of [`orthogonal_solve`]).
+    Unit,
     Holonomic(usize),
     Nonholonomic(usize),
 }
@@ -70,6 +72,18 @@ pub struct Plan {
     /// The rows added to $M$ (see the module docs): per row, the holonomic row and its
     /// entries `(column, index in cq)`.
     added: Vec<(usize, Vec<(usize, usize)>)>,
+    /// The metric is the identity (the orthogonal projection's system), and the
+    /// right-hand side's coordinate block is zero (see [`orthogonal_solve`]).
+    identity: bool,
+}
+
+/// The metric block of the augmented matrix.
+#[derive(Clone, Copy, Debug)]
+pub enum Metric<'a> {
+    /// The mass matrix with this pattern.
+    Mass(&'a [Entry]),
+    /// The identity (orthogonal projection).
+    Identity,
 }
 
 /// The holonomic rows $C_r = \tfrac k2 \sum_c q_c^2 + \dots$ whose columns form a block
@@ -111,9 +125,13 @@ impl Plan {
     pub fn new(
         n: usize,
         (mh, nnh): (usize, usize),
-        (mass, cq, gm): (&[Entry], &[Entry], &[Entry]),
+        (metric, cq, gm): (Metric<'_>, &[Entry], &[Entry]),
         added: &[usize],
     ) -> Option<Plan> {
+        let (mass, identity) = match metric {
+            Metric::Mass(mass) => (mass, false),
+            Metric::Identity => (&[][..], true),
+        };
         let added = added
             .iter()
             .map(|&r| {
@@ -134,6 +152,12 @@ impl Plan {
             entries.insert((r, c), Source::Mass(k));
             if r == c {
                 diagonal[r] = true;
+            }
+        }
+        if identity {
+            for (i, d) in diagonal.iter_mut().enumerate() {
+                entries.insert((i, i), Source::Unit);
+                *d = true;
             }
         }
         if diagonal.iter().any(|d| !d) {
@@ -212,6 +236,7 @@ impl Plan {
             n,
             entries,
             added,
+            identity,
         };
         let mut operations = 0;
         for (k, terms) in plan.updates().iter().enumerate() {
@@ -384,8 +409,13 @@ impl Plan {
                     let e = lit(e);
                     Operand::new(quote!(g[#e]), 0)
                 }
+                Source::Unit => Operand::new(quote!(1.0), 0),
             })
         };
+        // With the identity metric the right-hand side's coordinate block is zero, and
+        // so are y and z at the coordinates' positions (their rows of L hold no other
+        // coordinate): their terms are left out.
+        let zero = |k: usize| self.identity && self.order[k] < n;
         let name = |prefix: &str, k: usize| quote::format_ident!("{}{}", prefix, k);
         // Ready times of the values: w (L D, by entry), l (by entry), d and r (pivot and
         // its reciprocal, by position), y, z and s (by position), t (Y, by entry).
@@ -402,9 +432,14 @@ impl Plan {
                 Operand::new(name("w", e).into_token_stream(), w_at[e])
             }
         };
+        // With the identity metric a coordinate's pivot is 1 exactly (no earlier
+        // column holds it), so it is neither tested nor inverted, and its column of L
+        // is its column of W: l is written w.
+        let unit = |k: usize| self.identity && self.order[k] < n;
         let ell = |i: usize, k: usize, l_at: &[u32]| {
             let e = index[&(i, k)];
-            Operand::new(name("l", e).into_token_stream(), l_at[e])
+            let prefix = if unit(k) { "w" } else { "l" };
+            Operand::new(name(prefix, e).into_token_stream(), l_at[e])
         };
         let ratio: TokenStream = format!("{PIVOT_RATIO:e}").parse().expect("a literal");
         let declined = quote!(return ::pfaff::__private::AugmentedSolve::Declined;);
@@ -419,7 +454,10 @@ impl Plan {
             // The forward substitution's row k: y_k = b_k − Σ l_kj y_j.
             let b = lit(self.order[k]);
             let mut items = vec![(false, Operand::new(quote!(x[#b]), 0))];
-            for &j in &rows[k] {
+            if zero(k) {
+                items.clear();
+            }
+            for &j in rows[k].iter().filter(|&&j| !zero(j)) {
                 let a = Operand::product(vec![
                     ell(k, j, &l_at),
                     Operand::new(name("y", j).into_token_stream(), y_at[j]),
@@ -430,10 +468,12 @@ impl Plan {
                 ]);
                 items.push((true, Operand::earlier(a, b)));
             }
-            let y = Operand::sum(items);
-            y_at[k] = y.ready;
-            let (yn, yc) = (name("y", k), y.code);
-            code.extend(quote!(let #yn = #yc;));
+            if !items.is_empty() {
+                let y = Operand::sum(items);
+                y_at[k] = y.ready;
+                let (yn, yc) = (name("y", k), y.code);
+                code.extend(quote!(let #yn = #yc;));
+            }
             // Row k of Y (the multipliers' block): Y_kq = l_kq − Σ l_kj Y_jq.
             if let Some(inverse) = &inverse {
                 for q in n..k {
@@ -467,6 +507,18 @@ impl Plan {
             };
             // The pivot, checked against the diagonal it started from.
             let dn = name("d", k);
+            if unit(k) {
+                assert!(terms[&k].is_empty(), "a unit pivot with updates");
+                for &i in &self.columns[k] {
+                    let e = index[&(i, k)];
+                    let a = source(i, k).expect("an entry of J");
+                    w_at[e] = a.ready;
+                    l_at[e] = a.ready;
+                    let (wn, ac) = (name("w", e), a.code);
+                    code.extend(quote!(let #wn = #ac;));
+                }
+                continue;
+            }
             if !multiplier {
                 let mut a = source(k, k).expect("a diagonal mass entry");
                 if added.contains_key(&(self.order[k], self.order[k])) {
@@ -532,16 +584,18 @@ impl Plan {
             let (rn, zn, yn) = (name("r", k), name("z", k), name("y", k));
             if self.columns[k].is_empty() {
                 // No column: the reciprocal would serve z alone.
-                z_at[k] = d_at[k].max(y_at[k]) + DIV;
-                code.extend(quote!(let #zn = #yn / #dn;));
+                if !zero(k) {
+                    z_at[k] = d_at[k].max(y_at[k]) + DIV;
+                    code.extend(quote!(let #zn = #yn / #dn;));
+                }
                 continue;
             }
             r_at[k] = d_at[k] + DIV;
             z_at[k] = r_at[k].max(y_at[k]) + MUL;
-            code.extend(quote! {
-                let #rn = 1.0 / #dn;
-                let #zn = #yn * #rn;
-            });
+            code.extend(quote!(let #rn = 1.0 / #dn;));
+            if !zero(k) {
+                code.extend(quote!(let #zn = #yn * #rn;));
+            }
             // The column: w_ik = a_ik − Σ l_ij w_kj (the sign of the block in the
             // multipliers' rows and columns), l_ik = w_ik r_k.
             for &i in &self.columns[k] {
@@ -570,6 +624,9 @@ impl Plan {
         let z_op = |k: usize| Operand::new(name("z", k).into_token_stream(), z_at[k]);
         for k in (0..dim).rev() {
             let mut items = vec![(false, z_op(k))];
+            if zero(k) {
+                items.clear();
+            }
             match &inverse {
                 Some(inverse) if k >= n => {
                     // s_k = z_k − Σ_p Y_pk z_p.
@@ -588,9 +645,15 @@ impl Plan {
                     }
                 }
             }
+            let sn = name("s", k);
+            if items.is_empty() {
+                // A coordinate in no constraint row, with the identity metric.
+                code.extend(quote!(let #sn = 0.0;));
+                continue;
+            }
             let s = Operand::sum(items);
             s_at[k] = s.ready;
-            let (sn, sc) = (name("s", k), s.code);
+            let sc = s.code;
             code.extend(quote!(let #sn = #sc;));
         }
         for k in 0..dim {
@@ -640,6 +703,22 @@ impl Plan {
                 _ => None,
             }),
         );
+        if self.identity {
+            return quote! {
+                fn orthogonal_solve(
+                    &self,
+                    #cq: &[f64],
+                    #g: &[f64],
+                    x: &mut [f64],
+                ) -> ::pfaff::__private::AugmentedSolve {
+                    #cq_cut
+                    #g_cut
+                    let x = &mut x[..#dl];
+                    #code
+                    ::pfaff::__private::AugmentedSolve::Solved
+                }
+            };
+        }
         quote! {
             fn augmented_solve(
                 &self,
@@ -782,7 +861,32 @@ pub fn augmented_solve(
     (mass, cq, gm): (&[Entry], &[Entry], &[Entry]),
 ) -> TokenStream {
     let added = normalization_rows(g, mass, cq);
-    match Plan::new(n, rows, (mass, cq, gm), &added) {
+    match Plan::new(n, rows, (Metric::Mass(mass), cq, gm), &added) {
+        Some(plan) if plan.operations <= BUDGET && n > 0 => plan.emit(),
+        _ => TokenStream::new(),
+    }
+}
+
+/// The trait method `orthogonal_solve` for the patterns of $C_q$ and $G$: the
+/// solve of $[I\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; r]$, so
+/// $\Delta = J^\mathsf{T}(J J^\mathsf{T})^{-1} r$, the least change with
+/// $J\Delta = r$ (with $r = -(J\dot q + c)$ the orthogonal projection of velocities),
+/// by the same factorization as [`augmented_solve`] with the
+/// identity in place of $M$. The coordinates' pivots are then 1 (the compiler folds
+/// them), the multipliers' block is the Gram matrix $J J^\mathsf{T}$ formed from the
+/// patterns, and the right-hand side's coordinate block is taken as zero (its terms
+/// are left out). Emitted for models with constraint rows, every row with an entry,
+/// within [`BUDGET`]; partitioning projects the velocities of every evaluation with it
+/// (`runtime/src/sim/chart.rs`).
+pub fn orthogonal_solve(
+    n: usize,
+    rows: (usize, usize),
+    (cq, gm): (&[Entry], &[Entry]),
+) -> TokenStream {
+    if rows.0 + rows.1 == 0 {
+        return TokenStream::new();
+    }
+    match Plan::new(n, rows, (Metric::Identity, cq, gm), &[]) {
         Some(plan) if plan.operations <= BUDGET && n > 0 => plan.emit(),
         _ => TokenStream::new(),
     }
