@@ -111,6 +111,14 @@ struct Maps {
     /// non-holonomic), row-major `m × m`, and whether $G_a$ is regular.
     velocity_map: Vec<f64>,
     velocity_map_regular: bool,
+    /// Whether `velocity_map` holds this anchor's $G_a^{-1}$. When every row is
+    /// holonomic it is the inverse of `factor` and is made at the first chord update
+    /// that needs it: the model's generated orthogonal solve projects the velocities
+    /// of most evaluations, and an anchor whose map no update reads costs no inverse.
+    velocity_map_made: bool,
+    /// The Cholesky factor of $N N^\mathsf{T}$ (of $G_a$ too when every row is
+    /// holonomic).
+    factor: SmallCholesky,
     /// For each constraint row, its place in `rows` (`usize::MAX` when not projected).
     slot: Vec<usize>,
     /// The rows of the point's projections when anchored (the first `rows_h`
@@ -174,6 +182,8 @@ impl Maps {
             position_map: vec![0.0; n * r],
             velocity_map: vec![0.0; m * m],
             velocity_map_regular: false,
+            velocity_map_made: false,
+            factor: SmallCholesky::new(r),
             slot: vec![usize::MAX; m],
             rows: Vec::with_capacity(m),
             rows_h: 0,
@@ -236,16 +246,19 @@ impl Maps {
             gram.resize(m);
             let ratio = gram_cholesky_planned(gram, &self.normals, plan_v);
             gram.inverse_into(&mut self.velocity_map);
+            self.velocity_map_made = true;
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
-        gram.resize(r);
-        let ratio = gram_cholesky_planned(gram, &self.normals, plan_h);
+        let factor = &mut self.factor;
+        factor.resize(r);
+        let ratio = gram_cholesky_planned(factor, &self.normals, plan_h);
         for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
             out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
         }
-        gram.solve_rows(&mut self.position_map, n);
+        factor.solve_rows(&mut self.position_map, n);
         if m == r {
-            gram.inverse_into(&mut self.velocity_map);
+            // Made when first read (`inverse_gram`).
+            self.velocity_map_made = false;
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
         self.ratio = ratio;
@@ -273,7 +286,13 @@ impl Maps {
                     *v = -x;
                 }
             }
-            None => symmetric_product(&self.velocity_map, mu, nu),
+            None => {
+                if !self.velocity_map_made {
+                    self.factor.inverse_into(&mut self.velocity_map);
+                    self.velocity_map_made = true;
+                }
+                symmetric_product(&self.velocity_map, mu, nu);
+            }
         }
     }
 
