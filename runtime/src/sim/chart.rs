@@ -32,8 +32,8 @@
 //! (no generated solve, or it declines: dependent or nearly dependent rows), the chord
 //! iteration
 //! $\dot q \leftarrow \dot q - J^\mathsf{T} G_a^{-1}(J\dot q + [C_t; g])$ with the inverse
-//! of the anchor's $G_a = J_a J_a^\mathsf{T}$ (made once per step) converges to the
-//! orthogonal projection at $q$ (every update lies in the range of $J(q)^\mathsf{T}$) at
+//! of the anchor's $G_a = J_a J_a^\mathsf{T}$ (made once per anchor, when first read)
+//! converges to the orthogonal projection at $q$ (every update lies in the range of $J(q)^\mathsf{T}$) at
 //! the rate $\lVert I - J J^\mathsf{T} G_a^{-1}\rVert$, proportional to the distance from
 //! the anchor like the positions'; each update is a product with the pattern of $J$
 //! (by rows), one with an `m × m` matrix and one with the pattern of $J^\mathsf{T}$ (by
@@ -702,6 +702,14 @@ impl Chart {
         self.iterate_velocities(info, terms, distance, qd, kappa, false)
     }
 
+    /// The pattern layout of $J$ for `n` coordinates, made at the first velocity
+    /// projection (once per simulation: the patterns are the model's).
+    fn build_layout(&mut self, info: &Info, n: usize) {
+        if !self.layout.built {
+            self.layout = Layout::new(info, n, self.vel.len());
+        }
+    }
+
     /// Whether [`exact_projection`](Self::exact_projection) may serve the current (or
     /// the staged) maps: the model's solve is not known to be unavailable and every
     /// row is projected.
@@ -724,9 +732,7 @@ impl Chart {
         if !self.exact_ready(staged) {
             return false;
         }
-        if !self.layout.built {
-            self.layout = Layout::new(info, qd.len(), self.vel.len());
-        }
+        self.build_layout(info, qd.len());
         let n = qd.len();
         self.layout.residuals(terms, qd, &mut self.vel);
         for (r, v) in self.exact[n..].iter_mut().zip(&self.vel) {
@@ -761,10 +767,7 @@ impl Chart {
         kappa: f64,
         staged: bool,
     ) -> Option<usize> {
-        if !self.layout.built {
-            // Once per simulation (the patterns are the model's).
-            self.layout = Layout::new(info, qd.len(), self.vel.len());
-        }
+        self.build_layout(info, qd.len());
         let maps = if staged {
             &mut self.staged
         } else {

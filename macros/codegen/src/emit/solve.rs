@@ -412,10 +412,12 @@ impl Plan {
                 Source::Unit => Operand::new(quote!(1.0), 0),
             })
         };
-        // With the identity metric the right-hand side's coordinate block is zero, and
-        // so are y and z at the coordinates' positions (their rows of L hold no other
-        // coordinate): their terms are left out.
-        let zero = |k: usize| self.identity && self.order[k] < n;
+        // With the identity metric a coordinate's pivot is 1 exactly (no earlier column
+        // holds it), so it is neither tested nor inverted, and its column of L is its
+        // column of W (l is written w); the right-hand side's coordinate block is zero,
+        // and so are y and z at the coordinates' positions (their rows of L hold no
+        // other coordinate): their terms are left out.
+        let unit = |k: usize| self.identity && self.order[k] < n;
         let name = |prefix: &str, k: usize| quote::format_ident!("{}{}", prefix, k);
         // Ready times of the values: w (L D, by entry), l (by entry), d and r (pivot and
         // its reciprocal, by position), y, z and s (by position), t (Y, by entry).
@@ -432,10 +434,6 @@ impl Plan {
                 Operand::new(name("w", e).into_token_stream(), w_at[e])
             }
         };
-        // With the identity metric a coordinate's pivot is 1 exactly (no earlier
-        // column holds it), so it is neither tested nor inverted, and its column of L
-        // is its column of W: l is written w.
-        let unit = |k: usize| self.identity && self.order[k] < n;
         let ell = |i: usize, k: usize, l_at: &[u32]| {
             let e = index[&(i, k)];
             let prefix = if unit(k) { "w" } else { "l" };
@@ -454,10 +452,10 @@ impl Plan {
             // The forward substitution's row k: y_k = b_k − Σ l_kj y_j.
             let b = lit(self.order[k]);
             let mut items = vec![(false, Operand::new(quote!(x[#b]), 0))];
-            if zero(k) {
+            if unit(k) {
                 items.clear();
             }
-            for &j in rows[k].iter().filter(|&&j| !zero(j)) {
+            for &j in rows[k].iter().filter(|&&j| !unit(j)) {
                 let a = Operand::product(vec![
                     ell(k, j, &l_at),
                     Operand::new(name("y", j).into_token_stream(), y_at[j]),
@@ -584,18 +582,16 @@ impl Plan {
             let (rn, zn, yn) = (name("r", k), name("z", k), name("y", k));
             if self.columns[k].is_empty() {
                 // No column: the reciprocal would serve z alone.
-                if !zero(k) {
-                    z_at[k] = d_at[k].max(y_at[k]) + DIV;
-                    code.extend(quote!(let #zn = #yn / #dn;));
-                }
+                z_at[k] = d_at[k].max(y_at[k]) + DIV;
+                code.extend(quote!(let #zn = #yn / #dn;));
                 continue;
             }
             r_at[k] = d_at[k] + DIV;
             z_at[k] = r_at[k].max(y_at[k]) + MUL;
-            code.extend(quote!(let #rn = 1.0 / #dn;));
-            if !zero(k) {
-                code.extend(quote!(let #zn = #yn * #rn;));
-            }
+            code.extend(quote! {
+                let #rn = 1.0 / #dn;
+                let #zn = #yn * #rn;
+            });
             // The column: w_ik = a_ik − Σ l_ij w_kj (the sign of the block in the
             // multipliers' rows and columns), l_ik = w_ik r_k.
             for &i in &self.columns[k] {
@@ -624,7 +620,7 @@ impl Plan {
         let z_op = |k: usize| Operand::new(name("z", k).into_token_stream(), z_at[k]);
         for k in (0..dim).rev() {
             let mut items = vec![(false, z_op(k))];
-            if zero(k) {
+            if unit(k) {
                 items.clear();
             }
             match &inverse {
@@ -703,26 +699,16 @@ impl Plan {
                 _ => None,
             }),
         );
-        if self.identity {
-            return quote! {
-                fn orthogonal_solve(
-                    &self,
-                    #cq: &[f64],
-                    #g: &[f64],
-                    x: &mut [f64],
-                ) -> ::pfaff::__private::AugmentedSolve {
-                    #cq_cut
-                    #g_cut
-                    let x = &mut x[..#dl];
-                    #code
-                    ::pfaff::__private::AugmentedSolve::Solved
-                }
-            };
-        }
+        // The orthogonal solve reads no mass matrix.
+        let (name, mass_param) = if self.identity {
+            (quote!(orthogonal_solve), TokenStream::new())
+        } else {
+            (quote!(augmented_solve), quote!(#mass: &[f64],))
+        };
         quote! {
-            fn augmented_solve(
+            fn #name(
                 &self,
-                #mass: &[f64],
+                #mass_param
                 #cq: &[f64],
                 #g: &[f64],
                 x: &mut [f64],
