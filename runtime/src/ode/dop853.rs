@@ -47,47 +47,60 @@ pub(crate) struct Dp853 {
     cont: [Vec<f64>; 8],
 }
 
-/// Components [`combine`] sums together (two SSE2 registers).
-const LANES: usize = 4;
-
 /// `out = y + h * sum_j a_j k_j` over the listed coefficients.
 ///
-/// Four components at a time with the sums in registers: each entry sees the
-/// operations of a pass per coefficient ($o \leftarrow y$, then $o \mathrel{+}=
-/// (h a_j) k_j$ in the order of the list), without storing and reloading `out` once
-/// per coefficient (stage 12 has eleven).
+/// Each entry sees the operations of a pass per coefficient ($o \leftarrow y$, then
+/// $o \mathrel{+}= (h a_j) k_j$ in the order of the list), with the sum in a register.
+/// Dispatched on the number of coefficients (1 to 12 in the tableau) so that the loop
+/// over the components runs with the stage derivatives' slices and the products
+/// $h a_j$ held outside it, no bounds check inside, and the compiler's vectorization
+/// across components; measured by instruction counts in ARCHITECTURE.md ("the
+/// stages' sums by the number of their terms").
 #[inline]
 fn combine(out: &mut [f64], y: &[f64], h: f64, coeffs: &[(usize, f64)], k: &[Vec<f64>]) {
-    let n = out.len();
-    let mut l0 = 0;
-    while l0 + LANES <= n {
-        combine_lanes::<LANES>(out, y, h, coeffs, k, l0);
-        l0 += LANES;
+    macro_rules! by_len {
+        ($($l:literal)*) => {
+            match coeffs.len() {
+                $($l => combine_n::<$l>(out, y, h, coeffs, k),)*
+                _ => combine_any(out, y, h, coeffs, k),
+            }
+        };
     }
-    for l0 in l0..n {
-        combine_lanes::<1>(out, y, h, coeffs, k, l0);
-    }
+    by_len!(0 1 2 3 4 5 6 7 8 9 10 11 12);
 }
 
-/// [`combine`] for the components `l0..l0 + W`.
+/// [`combine`] for `L` coefficients.
 #[inline(always)]
-fn combine_lanes<const W: usize>(
+fn combine_n<const L: usize>(
     out: &mut [f64],
     y: &[f64],
     h: f64,
     coeffs: &[(usize, f64)],
     k: &[Vec<f64>],
-    l0: usize,
 ) {
-    let mut s = <[f64; W]>::try_from(&y[l0..l0 + W]).expect("W entries");
+    let n = out.len();
+    let y = &y[..n];
+    let ks: [&[f64]; L] = std::array::from_fn(|c| &k[coeffs[c].0][..n]);
+    let ha: [f64; L] = std::array::from_fn(|c| h * coeffs[c].1);
+    for (i, (o, y)) in out.iter_mut().zip(y).enumerate() {
+        let mut s = *y;
+        for (a, kj) in ha.iter().zip(&ks) {
+            s += a * kj[i];
+        }
+        *o = s;
+    }
+}
+
+/// [`combine`] for any number of coefficients (none of the tableau's).
+#[cold]
+fn combine_any(out: &mut [f64], y: &[f64], h: f64, coeffs: &[(usize, f64)], k: &[Vec<f64>]) {
+    out.copy_from_slice(y);
     for &(j, a) in coeffs {
         let ha = h * a;
-        let kj = <&[f64; W]>::try_from(&k[j][l0..l0 + W]).expect("W entries");
-        for (s, kj) in s.iter_mut().zip(kj) {
-            *s += ha * kj;
+        for (o, kj) in out.iter_mut().zip(&k[j]) {
+            *o += ha * kj;
         }
     }
-    out[l0..l0 + W].copy_from_slice(&s);
 }
 
 impl Dop853 {
@@ -169,36 +182,41 @@ impl Dp853 {
 }
 
 impl Dp853 {
-    /// The error sums of [`attempt`](EmbeddedRk::attempt) for the components
-    /// `l0..l0 + W`: the two error estimates summed in registers coefficient by
-    /// coefficient (each entry sees the operations of `dop853.f` in their order), then
-    /// added to `e3` and `e5` component by component, in order.
+    /// The error sums $(E_3, E_5)$ of [`attempt`](EmbeddedRk::attempt): per component,
+    /// the two error estimates summed in registers coefficient by coefficient (each
+    /// entry sees the operations of `dop853.f` in their order), then added to the sums
+    /// component by component, in order. The stages' slices are taken once, outside
+    /// the loop (see [`combine_n`]).
     #[inline(always)]
-    fn error_lanes<const W: usize>(&self, st: &RkState, l0: usize, e3: &mut f64, e5: &mut f64) {
-        let (mut err3, mut err5) = ([0.0; W], [0.0; W]);
-        let lanes = |j: usize| <&[f64; W]>::try_from(&self.k[j][l0..l0 + W]).expect("W entries");
-        for &(j, b) in A[FSAL] {
-            for (e, k) in err3.iter_mut().zip(lanes(j)) {
-                *e += b * k;
-            }
-        }
-        for &(j, b) in BHH {
-            for (e, k) in err3.iter_mut().zip(lanes(j)) {
-                *e -= b * k;
-            }
-        }
-        for &(j, c) in ER {
-            for (e, k) in err5.iter_mut().zip(lanes(j)) {
-                *e += c * k;
-            }
-        }
+    fn error_sums(&self, st: &RkState) -> (f64, f64) {
+        const NB: usize = A[FSAL].len();
+        const NH: usize = BHH.len();
+        const NE: usize = ER.len();
+        let n = st.y.len();
+        let slices = |list: &'static [(usize, f64)], c: usize| &self.k[list[c].0][..n];
+        let kb: [&[f64]; NB] = std::array::from_fn(|c| slices(A[FSAL], c));
+        let kh: [&[f64]; NH] = std::array::from_fn(|c| slices(BHH, c));
+        let ke: [&[f64]; NE] = std::array::from_fn(|c| slices(ER, c));
+        let (y, y_new) = (&st.y[..n], &st.y_new[..n]);
         let tol = &st.opts.tol;
-        for (w, (err3, err5)) in err3.iter().zip(&err5).enumerate() {
-            let i = l0 + w;
-            let sk = tol.atol(i) + tol.rtol * st.y[i].abs().max(st.y_new[i].abs());
-            *e3 += (err3 / sk) * (err3 / sk);
-            *e5 += (err5 / sk) * (err5 / sk);
+        let (mut e3, mut e5) = (0.0, 0.0);
+        for i in 0..n {
+            let mut err3 = 0.0;
+            for (&(_, b), k) in A[FSAL].iter().zip(&kb) {
+                err3 += b * k[i];
+            }
+            for (&(_, b), k) in BHH.iter().zip(&kh) {
+                err3 -= b * k[i];
+            }
+            let mut err5 = 0.0;
+            for (&(_, c), k) in ER.iter().zip(&ke) {
+                err5 += c * k[i];
+            }
+            let sk = tol.atol(i) + tol.rtol * y[i].abs().max(y_new[i].abs());
+            e3 += (err3 / sk) * (err3 / sk);
+            e5 += (err5 / sk) * (err5 / sk);
         }
+        (e3, e5)
     }
 }
 
@@ -224,16 +242,7 @@ impl EmbeddedRk for Dp853 {
         if check_state(st.t + h, &st.y_new).is_err() {
             return Ok(f64::INFINITY);
         }
-        let (mut e5, mut e3) = (0.0, 0.0);
-        let n = st.y.len();
-        let mut l0 = 0;
-        while l0 + LANES <= n {
-            self.error_lanes::<LANES>(st, l0, &mut e3, &mut e5);
-            l0 += LANES;
-        }
-        for l0 in l0..n {
-            self.error_lanes::<1>(st, l0, &mut e3, &mut e5);
-        }
+        let (e3, e5) = self.error_sums(st);
         let deno = if e5 + 0.01 * e3 > 0.0 {
             e5 + 0.01 * e3
         } else {
