@@ -24,10 +24,11 @@ pub(crate) fn coordinate_size(q: &[f64]) -> f64 {
     inf_norm(q)
 }
 
-/// The largest residual that row `row` (length $n$) of the Jacobian lets a met
-/// constraint keep: $\varepsilon\,\lVert (C_q)_i\rVert_\infty\, s_q$.
-pub(crate) fn residual_bound(row: &[f64], tolerance: f64, size: f64) -> f64 {
-    tolerance * inf_norm(row) * size
+/// Whether the residual `ci` of a constraint whose Jacobian row has the norm `norm` is
+/// met to the relative `tolerance` (see the module docs); a NaN residual never is.
+#[inline]
+fn met(ci: f64, norm: f64, tolerance: f64, size: f64) -> bool {
+    !(ci.is_nan() || ci.abs() > tolerance * norm * size)
 }
 
 /// The constraints of `c` not met to the relative `tolerance` (see the module docs),
@@ -40,15 +41,42 @@ pub(crate) fn unmet<'a>(
     tolerance: f64,
     size: f64,
 ) -> impl Iterator<Item = usize> + 'a {
-    c.iter().enumerate().filter_map(move |(i, ci)| {
-        let bound = residual_bound(&jacobian[i * n..(i + 1) * n], tolerance, size);
-        (ci.is_nan() || ci.abs() > bound).then_some(i)
+    c.iter().enumerate().filter_map(move |(i, &ci)| {
+        let norm = inf_norm(&jacobian[i * n..(i + 1) * n]);
+        (!met(ci, norm, tolerance, size)).then_some(i)
     })
 }
 
 /// Whether every constraint of `c` is met (see [`unmet`]).
 pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, size: f64) -> bool {
     unmet(c, jacobian, n, tolerance, size).next().is_none()
+}
+
+/// The row norms $\lVert (C_q)_i\rVert_\infty$ of a Jacobian given by its `pattern`
+/// (entries in any order) and `values`, into `norms` (one per row): the numbers
+/// [`inf_norm`] gives on the dense rows, whose other entries are zeros (the maximum is
+/// exact; a NaN entry makes its row's norm NaN). What the projections' convergence
+/// tests read, without scattering the dense $C_q$.
+pub(crate) fn pattern_row_norms(pattern: &[(u32, u32)], values: &[f64], norms: &mut [f64]) {
+    norms.fill(0.0);
+    for (&(r, _), v) in pattern.iter().zip(values) {
+        let (norm, a) = (&mut norms[r as usize], v.abs());
+        // Once NaN, a row stays NaN: `a > NaN` is false.
+        *norm = if a > *norm || a.is_nan() { a } else { *norm };
+    }
+}
+
+/// [`all_met`] with the row norms of $C_q$ given (see [`pattern_row_norms`]): the
+/// same decision.
+pub(crate) fn all_met_by_norms(c: &[f64], norms: &[f64], tolerance: f64, size: f64) -> bool {
+    c.iter()
+        .zip(norms)
+        .all(|(&ci, &norm)| met(ci, norm, tolerance, size))
+}
+
+/// [`at_rounding_floor`] with the row norms of $C_q$ given: the same decision.
+pub(crate) fn at_rounding_floor_by_norms(c: &[f64], norms: &[f64], size: f64) -> bool {
+    all_met_by_norms(c, norms, ROUNDING_FLOOR, size.max(1.0))
 }
 
 /// Whether every constraint of `c` is within its rounding floor
@@ -62,9 +90,11 @@ pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, siz
 /// holds; the unit scale is a floor for angles (1 rad) that only applies after
 /// stagnation, where further iterations cannot improve the point.
 pub(crate) fn at_rounding_floor(c: &[f64], jacobian: &[f64], n: usize, size: f64) -> bool {
-    let floor = 64.0 * f64::EPSILON;
-    all_met(c, jacobian, n, floor, size.max(1.0))
+    all_met(c, jacobian, n, ROUNDING_FLOOR, size.max(1.0))
 }
+
+/// The relative tolerance of [`at_rounding_floor`].
+const ROUNDING_FLOOR: f64 = 64.0 * f64::EPSILON;
 
 #[cfg(test)]
 mod tests {
@@ -95,6 +125,50 @@ mod tests {
         assert!(!all_met(&c, &jacobian, 2, 1e-14, size));
         assert!(at_rounding_floor(&c, &jacobian, 2, size));
         assert!(!at_rounding_floor(&[1e-10], &jacobian, 2, size));
+    }
+
+    /// The norms from a pattern in any order are the dense rows' norms, NaN included,
+    /// and the decisions from them are the dense decisions.
+    #[test]
+    fn pattern_row_norms_are_the_dense_ones() {
+        let n = 3;
+        // Rows 0 and 2 in a scattered order; row 1 empty; row 3 with a NaN entry.
+        let pattern = [(2, 1), (0, 2), (3, 0), (2, 0), (0, 0), (3, 2)];
+        let values = [-4.0, 0.5, 1.0, 3.0, -2.0, f64::NAN];
+        let mut dense = vec![0.0; 4 * n];
+        for (&(r, c), &v) in pattern.iter().zip(&values) {
+            dense[r as usize * n + c as usize] = v;
+        }
+        let mut norms = [7.0; 4];
+        pattern_row_norms(&pattern, &values, &mut norms);
+        for (i, &norm) in norms.iter().enumerate() {
+            let d = inf_norm(&dense[i * n..(i + 1) * n]);
+            assert!(norm == d || (norm.is_nan() && d.is_nan()), "row {i}");
+        }
+        assert_eq!(norms[..3], [2.0, 0.0, 4.0]);
+        for c in [
+            [1e-13, 0.0, 1e-13, 0.0],
+            [1e-13, 1e-300, 0.0, 5.0],
+            [3e-12, 0.0, 0.0, 0.0],
+        ] {
+            for tol in [1e-12, 1e-14] {
+                assert_eq!(
+                    all_met_by_norms(&c, &norms, tol, 1.0),
+                    all_met(&c, &dense, n, tol, 1.0),
+                    "{c:?} at {tol}"
+                );
+            }
+            assert_eq!(
+                at_rounding_floor_by_norms(&c, &norms, 0.5),
+                at_rounding_floor(&c, &dense, n, 0.5)
+            );
+        }
+        assert!(!all_met_by_norms(
+            &[f64::NAN, 0.0, 0.0, 0.0],
+            &norms,
+            1.0,
+            1.0
+        ));
     }
 
     #[test]

@@ -332,6 +332,8 @@ pub struct Workspace {
     /// $[\gamma_h; \gamma_{nh}]$ (length $m$).
     pub(crate) gamma: Vec<f64>,
     pub(crate) forces: Vec<f64>,
+    /// The row norms of $C_q$ of [`constraints_and_row_norms`](Self::constraints_and_row_norms).
+    row_norms: Vec<f64>,
 }
 
 impl Workspace {
@@ -365,6 +367,7 @@ impl Workspace {
             bias: vec![0.0; mnh],
             gamma: vec![0.0; mh + mnh],
             forces: vec![0.0; n],
+            row_norms: vec![0.0; mh],
         })
     }
 
@@ -755,6 +758,18 @@ impl Workspace {
     #[must_use]
     pub fn jacobian(&self) -> &[f64] {
         &self.jacobian
+    }
+
+    /// $C$ of the last [`Workspace::eval_constraints`] and the row norms of the $C_q$
+    /// held in the pattern values ([`scale::pattern_row_norms`](crate::scale)): what the
+    /// projections' convergence tests read, without the dense $C_q$.
+    pub(crate) fn constraints_and_row_norms(&mut self) -> (&[f64], &[f64]) {
+        crate::scale::pattern_row_norms(
+            self.info.holonomic_pattern,
+            &self.cq_values,
+            &mut self.row_norms,
+        );
+        (&self.c, &self.row_norms)
     }
 
     /// $C$ of the last [`Workspace::eval_constraints`].

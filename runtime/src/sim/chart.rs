@@ -515,17 +515,16 @@ impl Chart {
         t: f64,
         tolerance: f64,
     ) -> Result<Option<usize>, EvalError> {
-        let n = p.q.len();
         let r = self.staged.rows_h;
         let mut previous = f64::INFINITY;
         for iteration in 0..=POLISH_ITERATIONS {
             p.constraints(t)?;
-            p.dense_jacobian(t)?;
+            p.jacobian_values(t)?;
             let size = scale::coordinate_size(&p.q);
-            let (c, jac) = (p.ws.constraints(), p.ws.jacobian());
+            let (c, norms) = p.ws.constraints_and_row_norms();
             let residual = inf_norm(c);
-            if scale::all_met(c, jac, n, tolerance, size)
-                || (residual >= 0.5 * previous && scale::at_rounding_floor(c, jac, n, size))
+            if scale::all_met_by_norms(c, norms, tolerance, size)
+                || (residual >= 0.5 * previous && scale::at_rounding_floor_by_norms(c, norms, size))
             {
                 return Ok(Some(iteration));
             }
