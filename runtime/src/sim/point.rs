@@ -672,11 +672,14 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
     /// the same call when neither is held (the generated code computes $C$ from the
     /// sines it already has), [`constraints`](Self::constraints) when the terms are.
-    /// For callers that read $C$ at every point (Baumgarte's shift).
+    /// For callers that read $C$ at every point (Baumgarte's shift), which go on to
+    /// [`accelerations`](Self::accelerations): the terms are left unchecked for its
+    /// solve to vouch for (a non-finite term reaches the solution through the solve's
+    /// matrix or, by the shift, its right-hand side, and the check then names it); a
+    /// non-finite $C$ is not stamped, so it is evaluated again and named here.
     pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
         self.dynamics_terms_at(t, versions, true)?;
-        self.check_terms(t)?;
         if self.constraints != versions.0 {
             self.constraints(t).map_err(SimErrorKind::from_eval)?;
         }
