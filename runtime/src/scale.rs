@@ -58,12 +58,25 @@ pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, siz
 /// exact; a NaN entry makes its row's norm NaN). What the projections' convergence
 /// tests read, without scattering the dense $C_q$.
 pub(crate) fn pattern_row_norms(pattern: &[(u32, u32)], values: &[f64], norms: &mut [f64]) {
+    // Once NaN, a norm stays NaN: `a > NaN` is false.
+    let larger = |m: f64, a: f64| if a > m || a.is_nan() { a } else { m };
     norms.fill(0.0);
-    for (&(r, _), v) in pattern.iter().zip(values) {
-        let (norm, a) = (&mut norms[r as usize], v.abs());
-        // Once NaN, a row stays NaN: `a > NaN` is false.
-        *norm = if a > *norm || a.is_nan() { a } else { *norm };
+    // The maximum of a run of entries of one row in a register, stored when the row
+    // changes (not stored and reloaded entry by entry, each waiting for the last).
+    let mut entries = pattern.iter().zip(values);
+    let Some((&(r, _), v)) = entries.next() else {
+        return;
+    };
+    let (mut row, mut norm) = (r as usize, v.abs());
+    for (&(r, _), v) in entries {
+        let r = r as usize;
+        if r != row {
+            norms[row] = larger(norms[row], norm);
+            (row, norm) = (r, 0.0);
+        }
+        norm = larger(norm, v.abs());
     }
+    norms[row] = larger(norms[row], norm);
 }
 
 /// [`all_met`] with the row norms of $C_q$ given (see [`pattern_row_norms`]): the
