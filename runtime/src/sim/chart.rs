@@ -645,7 +645,8 @@ impl Chart {
         if !maps.serves(p) {
             return Ok(None);
         }
-        p.velocity_residuals(t)?;
+        // The projection forms its residuals from these (its own, at each update).
+        p.velocity_terms(t)?;
         let ws = &p.ws;
         let terms = VelocityTerms {
             cq: &ws.cq_values,

@@ -546,17 +546,26 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
-    /// functions evaluated once per $(t, q)$, the products with $\dot q$ every call).
-    pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
-        let info = self.info;
-        let mh = info.nh();
+    /// The pattern values of $C_q$ and $G$ and the rates $[C_t; g]$ at the current
+    /// $(t, q)$, in the workspace (each evaluated once per position): what a projection
+    /// of the velocities reads besides $\dot q$, for one that forms its residuals itself
+    /// (the chart's).
+    pub fn velocity_terms(&mut self, t: f64) -> Result<(), EvalError> {
         let at = self.position(t);
         self.jacobian_values_at(t, at)?;
         if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
         }
+        Ok(())
+    }
+
+    /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
+    /// functions evaluated once per $(t, q)$, the products with $\dot q$ every call).
+    pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
+        let info = self.info;
+        let mh = info.nh();
+        self.velocity_terms(t)?;
         let (holonomic, nonholonomic) = self.vel.split_at_mut(mh);
         holonomic.copy_from_slice(&self.ws.ct);
         nonholonomic.copy_from_slice(&self.ws.bias);
