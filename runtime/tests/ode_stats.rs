@@ -5,7 +5,7 @@
 //! Adams (PECE) 2 per accepted step + 1 per rejected attempt + 1 at reset.
 
 use pfaff::ode::samples::{Kepler, Oscillator};
-use pfaff::ode::{Adams, Dop853, Dopri5, Integrator, OdeOptions, Rk4};
+use pfaff::ode::{Adams, Dop853, Dopri5, Integrator, OdeOptions, OdeSystem, Rk4};
 use std::f64::consts::PI;
 
 #[test]
@@ -189,4 +189,59 @@ fn set_state_keeps_history() {
     let s = a.stats();
     let rejected = s.rejected - before.rejected;
     assert_eq!(s.rhs_evals - before.rhs_evals, 6 * (1 + rejected) + 1);
+}
+
+/// Records the time of each evaluation and of each evaluation announced by
+/// `step_end_next`, around the Kepler problem.
+struct Announced {
+    inner: Kepler,
+    pending: bool,
+    announced: Vec<f64>,
+}
+
+impl OdeSystem for Announced {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), pfaff::ode::RhsError> {
+        if std::mem::take(&mut self.pending) {
+            self.announced.push(t);
+        }
+        self.inner.rhs(t, y, dy)
+    }
+    fn step_end_next(&mut self) {
+        self.pending = true;
+    }
+}
+
+/// DOP853 announces its FSAL evaluation of every accepted step, and nothing else: the
+/// announced times are the accepted steps' ends. DOPRI5 announces its seventh stage,
+/// the end of every attempt (accepted or not).
+#[test]
+fn the_explicit_pairs_announce_the_evaluation_at_the_step_end() {
+    let y0 = Kepler { e: 0.5 }.y0();
+    let new = || Announced {
+        inner: Kepler { e: 0.5 },
+        pending: false,
+        announced: Vec::new(),
+    };
+    let mut sys = new();
+    let mut ode = Dop853::new(4, OdeOptions::with_tol(1e-8)).unwrap();
+    ode.reset(&mut sys, 0.0, &y0, Some(1.0)).unwrap();
+    let mut ends = Vec::new();
+    while ode.t() < 2.0 * PI {
+        ends.push(ode.step(&mut sys, Some(2.0 * PI)).unwrap());
+    }
+    assert!(
+        ode.stats().rejected > 0,
+        "the test should exercise rejections"
+    );
+    assert_eq!(sys.announced, ends);
+    let mut sys = new();
+    let mut ode = Dopri5::new(4, OdeOptions::with_tol(1e-8)).unwrap();
+    ode.reset(&mut sys, 0.0, &y0, Some(1.0)).unwrap();
+    ode.integrate_to(&mut sys, 2.0 * PI).unwrap();
+    let s = *ode.stats();
+    assert!(s.rejected > 0);
+    assert_eq!(sys.announced.len() as u64, s.steps + s.rejected);
 }

@@ -261,6 +261,7 @@ impl EmbeddedRk for Dp853 {
         h: f64,
         t_new: f64,
     ) -> Result<(), OdeError> {
+        sys.step_end_next();
         let mut fsal = eval(sys, &mut st.stats, t_new, &st.y_new, &mut self.k[FSAL]);
         self.dense_ready = false;
         let wanted = self.dense_from.is_none_or(|td| (t_new - td) * h >= 0.0);

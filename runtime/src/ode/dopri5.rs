@@ -162,6 +162,7 @@ impl EmbeddedRk for Dp5 {
             y_new[i] =
                 y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
         }
+        sys.step_end_next();
         eval(sys, stats, t + h, y_new, k7)?;
         for i in 0..n {
             tmp[i] =

@@ -46,6 +46,13 @@ pub trait OdeSystem {
     /// shortens the step by halves, and the error is returned only when the step size
     /// underflows.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError>;
+
+    /// Told just before an evaluation at the state a step ends in, $f(t_{n+1},
+    /// y_{n+1})$ (DOP853's and DOPRI5's first-same-as-last stage), which the caller
+    /// keeps if the step is accepted: a system that corrects or monitors the states it
+    /// keeps may compute with that evaluation what it reads there next. The default
+    /// does nothing.
+    fn step_end_next(&mut self) {}
 }
 
 /// A failure reported by [`OdeSystem::rhs`], carrying the system's own typed error.

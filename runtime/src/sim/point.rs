@@ -206,6 +206,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
     /// dynamics terms only where it is read").
     pub constraints_with_terms: bool,
+    /// $C$ with the next evaluation of the dynamics terms only (then cleared): set
+    /// before the evaluation at the state a step ends in, where the projections and the
+    /// monitors read $C$ next ([`OdeSystem::step_end_next`](crate::ode::OdeSystem)).
+    pub constraints_next: bool,
     /// Whether the dynamics terms held (stamp `terms`) passed their finiteness check:
     /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
     /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
@@ -268,6 +272,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             factorizations: 0,
             redundant: Vec::new(),
             constraints_with_terms: false,
+            constraints_next: false,
             terms_checked: true,
             solution_scratch: vec![0.0; n + m],
             rank: 0,
@@ -609,7 +614,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.solved == state {
             return Ok(());
         }
-        self.dynamics_terms_at(t, (position, state), self.constraints_with_terms)?;
+        let with_c = self.constraints_with_terms || std::mem::take(&mut self.constraints_next);
+        self.dynamics_terms_at(t, (position, state), with_c)?;
         self.factorizations += 1;
         // A model with redundant constraints gives the solve the velocity residuals,
         // for its check of the rows that are dependent only near a rank drop.
@@ -776,7 +782,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
         }
-        let with_c = self.constraints_with_terms && self.constraints != at;
+        let asked = self.constraints_with_terms || std::mem::take(&mut self.constraints_next);
+        let with_c = asked && self.constraints != at;
         self.jacobian = 0;
         self.terms = 0;
         if with_c {
@@ -1362,5 +1369,32 @@ mod tests {
         let expected = circle(&p);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (3, 0, 0));
+    }
+
+    /// [`Point::constraints_next`] gives $C$ with the next evaluation of the terms (the
+    /// accelerations' call), read there at no further cost, and only with that one:
+    /// the evaluation after it leaves $C$ to be evaluated where it is read.
+    #[test]
+    fn constraints_come_with_the_next_terms_once() {
+        let mech = Circle;
+        let mut p = Point::new(
+            &mech,
+            DynamicsParams::default(),
+            KinematicsParams::default(),
+        )
+        .expect("a point");
+        let circle = |p: &Point<'_, Circle>| p.q[0] * p.q[0] + p.q[1] * p.q[1] - 1.0;
+        p.set_state(&[1.2, 0.1, 0.3, -0.2]);
+        p.constraints_next = true;
+        p.accelerations(0.0, None).expect("accelerations");
+        assert!(!p.constraints_next);
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (0, 0, 0));
+        p.set_state(&[1.1, 0.2, 0.3, -0.2]);
+        p.accelerations(0.0, None).expect("accelerations");
+        let expected = circle(&p);
+        assert_eq!(p.constraints(0.0).expect("C")[0], expected);
+        assert_eq!(counts(&p), (1, 0, 0));
     }
 }

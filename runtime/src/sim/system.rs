@@ -137,6 +137,13 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
             }
         }
     }
+
+    /// $C$ with the next evaluation's terms: the correction of the kept state and the
+    /// monitors read it there (for a few operations on the sines the terms have, where
+    /// a call of its own would evaluate them again).
+    fn step_end_next(&mut self) {
+        self.point.constraints_next = true;
+    }
 }
 
 /// A mechanism under a [`Formulation`] as the simulation integrates it: an
@@ -299,5 +306,9 @@ impl<M: Mechanism + ?Sized> OdeSystem for StateSpace<'_, M> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         self.0.rhs(t, y, dy)
+    }
+
+    fn step_end_next(&mut self) {
+        self.0.step_end_next();
     }
 }
