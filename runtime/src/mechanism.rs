@@ -591,6 +591,31 @@ pub trait Mechanism {
         AugmentedSolve::Unavailable
     }
 
+    /// The orthogonal projection of the velocities `qd` onto $J\dot q + [C_t; g] = 0$
+    /// at a point with the pattern values `cq`, `g` and the rates `ct` ($C_t$, length
+    /// `m_h`) and `bias` ($g$, length `m_nh`): the residuals
+    /// $r = J\dot q + [C_t; g]$, then [`orthogonal_solve`](Self::orthogonal_solve) with
+    /// $[0; -r]$, and $\dot q \mathrel{+}= \Delta$, in place.
+    ///
+    /// The generator emits it beside the orthogonal solve, with the residuals as
+    /// straight-line sums over the patterns (each row's rate, then its entries in the
+    /// pattern's order: the runtime's sums to the bit) and the solve's buffer on the
+    /// stack. Returns what the solve returns, and [`AugmentedSolve::Declined`] with
+    /// `qd` unchanged when a change is not finite. The default returns
+    /// [`AugmentedSolve::Unavailable`] (the runtime then forms the residuals itself).
+    /// Allocates nothing.
+    fn orthogonal_projection(
+        &self,
+        cq: &[f64],
+        g: &[f64],
+        ct: &[f64],
+        bias: &[f64],
+        qd: &mut [f64],
+    ) -> AugmentedSolve {
+        let _ = (cq, g, ct, bias, qd);
+        AugmentedSolve::Unavailable
+    }
+
     /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin
     /// `(x, y, z)` and then the rotation matrix to the global frame, row-major. Planar
     /// frames have `z = 0` and turn about the z axis.

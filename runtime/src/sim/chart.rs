@@ -732,6 +732,13 @@ impl Chart {
         if !self.exact_ready(staged) {
             return false;
         }
+        // The model's projection, residuals included, where it has one; else the
+        // residuals here and its solve.
+        match mech.orthogonal_projection(terms.cq, terms.g, terms.ct, terms.bias, qd) {
+            AugmentedSolve::Solved => return true,
+            AugmentedSolve::Declined => return false,
+            AugmentedSolve::Unavailable => {}
+        }
         self.build_layout(info, qd.len());
         let n = qd.len();
         self.layout.residuals(terms, qd, &mut self.vel);

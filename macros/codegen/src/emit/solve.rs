@@ -873,7 +873,107 @@ pub fn orthogonal_solve(
         return TokenStream::new();
     }
     match Plan::new(n, rows, (Metric::Identity, cq, gm), &[]) {
-        Some(plan) if plan.operations <= BUDGET && n > 0 => plan.emit(),
+        Some(plan) if plan.operations <= BUDGET && n > 0 => {
+            let mut fns = plan.emit();
+            fns.extend(orthogonal_projection(n, rows, (cq, gm)));
+            fns
+        }
         _ => TokenStream::new(),
+    }
+}
+
+/// The trait method `orthogonal_projection`, beside `orthogonal_solve`: the residuals
+/// $r = J\dot q + [C_t; g]$ as straight-line sums over the patterns (each row's rate,
+/// then its entries in the pattern's order, left to right: the sums of the runtime's
+/// row-by-row loop, to the bit), the solve with $[0; -r]$ into a local array, and
+/// $\dot q \mathrel{+}= \Delta$ when every entry of $\Delta$ is finite.
+fn orthogonal_projection(
+    n: usize,
+    (mh, mnh): (usize, usize),
+    (cq, gm): (&[Entry], &[Entry]),
+) -> TokenStream {
+    let dim = n + mh + mnh;
+    let lit = Literal::usize_unsuffixed;
+    let residual = |rate: TokenStream, entries: &[(usize, &Entry)], values: &TokenStream| {
+        let mut sum = rate;
+        for &(k, e) in entries {
+            let (k, c) = (lit(k), lit(e.col as usize));
+            sum = quote!((#sum + #values[#k] * qd[#c]));
+        }
+        sum
+    };
+    let mut rows = TokenStream::new();
+    let (cq_name, g_name) = (quote!(cq), quote!(g));
+    for i in 0..mh {
+        let entries: Vec<(usize, &Entry)> = cq
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.row as usize == i)
+            .collect();
+        let (at, li) = (lit(n + i), lit(i));
+        let r = residual(quote!(ct[#li]), &entries, &cq_name);
+        rows.extend(quote!(x[#at] = -#r;));
+    }
+    for i in 0..mnh {
+        let entries: Vec<(usize, &Entry)> = gm
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.row as usize == i)
+            .collect();
+        let (at, li) = (lit(n + mh + i), lit(i));
+        let r = residual(quote!(bias[#li]), &entries, &g_name);
+        rows.extend(quote!(x[#at] = -#r;));
+    }
+    let (cq_len, g_len, n_lit, dim_lit) = (lit(cq.len()), lit(gm.len()), lit(n), lit(dim));
+    let (mh_lit, mnh_lit) = (lit(mh), lit(mnh));
+    let (g_param, g_cut) = if mnh == 0 {
+        (quote!(g), TokenStream::new())
+    } else {
+        (quote!(g), quote!(let g = &g[..#g_len];))
+    };
+    let (bias_param, bias_cut) = if mnh == 0 {
+        (quote!(_bias), TokenStream::new())
+    } else {
+        (quote!(bias), quote!(let bias = &bias[..#mnh_lit];))
+    };
+    let (ct_param, ct_cut) = if mh == 0 {
+        (quote!(_ct), TokenStream::new())
+    } else {
+        (quote!(ct), quote!(let ct = &ct[..#mh_lit];))
+    };
+    let cq_cut = if mh == 0 {
+        TokenStream::new()
+    } else {
+        quote!(let cq = &cq[..#cq_len];)
+    };
+    quote! {
+        fn orthogonal_projection(
+            &self,
+            cq: &[f64],
+            #g_param: &[f64],
+            #ct_param: &[f64],
+            #bias_param: &[f64],
+            qd: &mut [f64],
+        ) -> ::pfaff::__private::AugmentedSolve {
+            #cq_cut
+            #g_cut
+            #ct_cut
+            #bias_cut
+            let qd = &mut qd[..#n_lit];
+            let mut x = [0.0_f64; #dim_lit];
+            #rows
+            match self.orthogonal_solve(cq, g, &mut x) {
+                ::pfaff::__private::AugmentedSolve::Solved => {}
+                other => return other,
+            }
+            let delta = &x[..#n_lit];
+            if !delta.iter().all(|d| d.is_finite()) {
+                return ::pfaff::__private::AugmentedSolve::Declined;
+            }
+            for (v, d) in qd.iter_mut().zip(delta) {
+                *v += d;
+            }
+            ::pfaff::__private::AugmentedSolve::Solved
+        }
     }
 }
