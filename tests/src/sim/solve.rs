@@ -6,8 +6,8 @@
 
 use pfaff::sim::Simulation;
 use pfaff::{
-    AugmentedSolve, Dynamics, DynamicsParams, DynamicsTerms, LinearSolver, Mechanism, SolverPath,
-    Workspace,
+    AugmentedSolve, Dynamics, DynamicsParams, DynamicsTerms, Info, LinearSolver, Mechanism,
+    SolverPath, Workspace,
 };
 
 use crate::accuracy::util::Rng;
@@ -765,6 +765,21 @@ fn the_sparse_ldlt_agrees_with_the_lu_and_leaves_dependent_rows_to_it() {
     }
 }
 
+/// $J = [C_q; G]$'s entries as (row of all `m`, column, value), from the pattern values
+/// `cq` and `g`, in the patterns' order.
+fn jacobian_entries(info: &Info, cq: &[f64], g: &[f64]) -> Vec<(usize, usize, f64)> {
+    let mh = info.nh();
+    let entry = |offset: usize| {
+        move |(&(r, c), &v): (&(u32, u32), &f64)| (offset + r as usize, c as usize, v)
+    };
+    info.holonomic_pattern
+        .iter()
+        .zip(cq)
+        .map(entry(0))
+        .chain(info.nonholonomic_pattern.iter().zip(g).map(entry(mh)))
+        .collect()
+}
+
 /// The generated orthogonal solve (`Mechanism::orthogonal_solve`, the system
 /// $[I\ J^\mathsf{T}; J\ 0][\Delta; \mu] = [0; r]$ that partitioning's velocity
 /// projection solves at every evaluation) against its defining equations, which fix
@@ -789,18 +804,6 @@ fn the_orthogonal_solve_meets_its_defining_equations() {
             continue;
         }
         let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
-        // J's entries as (row of all m, column, index, holonomic).
-        let jac = |cq: &[f64], g: &[f64]| -> Vec<(usize, usize, f64)> {
-            hol.iter()
-                .zip(cq)
-                .map(|(&(r, c), &v)| (r as usize, c as usize, v))
-                .chain(
-                    non.iter()
-                        .zip(g)
-                        .map(|(&(r, c), &v)| (mh + r as usize, c as usize, v)),
-                )
-                .collect()
-        };
         if ["bricard", "parallelogram"].contains(&entry.name) {
             let (q, qd) = crate::states::moving_state(model, 0.05);
             let all = terms(model, 0.05, &q, &qd, false);
@@ -830,7 +833,7 @@ fn the_orthogonal_solve_meets_its_defining_equations() {
                 other => panic!("{}: {other:?} at a regular state", entry.name),
             }
             let (delta, mu) = x.split_at(n);
-            let entries = jac(cq, g);
+            let entries = jacobian_entries(info, cq, g);
             let mut jd = vec![0.0; m];
             let mut range = delta.to_vec();
             let mut size = vec![0.0_f64; m];
@@ -885,17 +888,8 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
             let (ct, bias) = (rng.vec(mh, -1.0, 1.0), rng.vec(mnh, -1.0, 1.0));
             // The runtime's way: residuals row by row, then the solve.
             let mut x = vec![0.0; n + m];
-            let rows = hol
-                .iter()
-                .zip(cq)
-                .map(|(&(r, c), &v)| (r as usize, c as usize, v))
-                .chain(
-                    non.iter()
-                        .zip(g)
-                        .map(|(&(r, c), &v)| (mh + r as usize, c as usize, v)),
-                );
             let mut residual: Vec<f64> = ct.iter().chain(&bias).copied().collect();
-            for (i, c, v) in rows {
+            for (i, c, v) in jacobian_entries(info, cq, g) {
                 residual[i] += v * qd[c];
             }
             for (x, r) in x[n..].iter_mut().zip(&residual) {
@@ -926,16 +920,7 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
             );
             let mut after: Vec<f64> = ct.iter().chain(&bias).copied().collect();
             let mut size = after.iter().map(|r| r.abs()).collect::<Vec<_>>();
-            let rows = hol
-                .iter()
-                .zip(cq)
-                .map(|(&(r, c), &v)| (r as usize, c as usize, v))
-                .chain(
-                    non.iter()
-                        .zip(g)
-                        .map(|(&(r, c), &v)| (mh + r as usize, c as usize, v)),
-                );
-            for (i, c, v) in rows {
+            for (i, c, v) in jacobian_entries(info, cq, g) {
                 after[i] += v * projected[c];
                 size[i] = size[i].max((v * projected[c]).abs());
             }

@@ -894,42 +894,33 @@ fn orthogonal_projection(
 ) -> TokenStream {
     let dim = n + mh + mnh;
     let lit = Literal::usize_unsuffixed;
-    let residual = |rate: TokenStream, entries: &[(usize, &Entry)], values: &TokenStream| {
-        let mut sum = rate;
-        for &(k, e) in entries {
-            let (k, c) = (lit(k), lit(e.col as usize));
-            sum = quote!((#sum + #values[#k] * qd[#c]));
-        }
-        sum
-    };
+    // Row i of a pattern: its rate, then its entries in the pattern's order.
     let mut rows = TokenStream::new();
-    let (cq_name, g_name) = (quote!(cq), quote!(g));
-    for i in 0..mh {
-        let entries: Vec<(usize, &Entry)> = cq
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| e.row as usize == i)
-            .collect();
-        let (at, li) = (lit(n + i), lit(i));
-        let r = residual(quote!(ct[#li]), &entries, &cq_name);
-        rows.extend(quote!(x[#at] = -#r;));
-    }
-    for i in 0..mnh {
-        let entries: Vec<(usize, &Entry)> = gm
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| e.row as usize == i)
-            .collect();
-        let (at, li) = (lit(n + mh + i), lit(i));
-        let r = residual(quote!(bias[#li]), &entries, &g_name);
-        rows.extend(quote!(x[#at] = -#r;));
+    for (entries, count, values, rates, first) in [
+        (cq, mh, quote!(cq), quote!(ct), n),
+        (gm, mnh, quote!(g), quote!(bias), n + mh),
+    ] {
+        for i in 0..count {
+            let li = lit(i);
+            let mut sum = quote!(#rates[#li]);
+            for (k, e) in entries
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.row as usize == i)
+            {
+                let (k, c) = (lit(k), lit(e.col as usize));
+                sum = quote!((#sum + #values[#k] * qd[#c]));
+            }
+            let at = lit(first + i);
+            rows.extend(quote!(x[#at] = -#sum;));
+        }
     }
     let (cq_len, g_len, n_lit, dim_lit) = (lit(cq.len()), lit(gm.len()), lit(n), lit(dim));
     let (mh_lit, mnh_lit) = (lit(mh), lit(mnh));
-    let (g_param, g_cut) = if mnh == 0 {
-        (quote!(g), TokenStream::new())
+    let g_cut = if mnh == 0 {
+        TokenStream::new()
     } else {
-        (quote!(g), quote!(let g = &g[..#g_len];))
+        quote!(let g = &g[..#g_len];)
     };
     let (bias_param, bias_cut) = if mnh == 0 {
         (quote!(_bias), TokenStream::new())
@@ -950,7 +941,7 @@ fn orthogonal_projection(
         fn orthogonal_projection(
             &self,
             cq: &[f64],
-            #g_param: &[f64],
+            g: &[f64],
             #ct_param: &[f64],
             #bias_param: &[f64],
             qd: &mut [f64],
