@@ -9,7 +9,15 @@
 //!   asking for $C$ (Baumgarte's shift, the projections after Adams) adds;
 //! - `generated+solve`: `dynamics_terms` and the model's generated `augmented_solve`
 //!   ($\ddot q$ and $\lambda$ from $M$, $Q$, $J$, $\gamma$): the index-1 right-hand
-//!   side in generated code alone, the floor of every formulation's;
+//!   side in generated code alone, the floor of every formulation's (projection's
+//!   own floor: the calls its right-hand side makes);
+//! - `floor/partitioning`, `floor/baumgarte`: the generated calls each of those
+//!   formulations' right-hand sides makes, in sequence with nothing between them:
+//!   partitioning's `holonomic` at the predicted positions, `dynamics_terms_corrected`
+//!   with the generated `orthogonal_projection` of the velocities inside it and the
+//!   `augmented_solve`; Baumgarte's `dynamics_terms` with $C$ and the
+//!   `augmented_solve` (the rates $C_t$, $g$ too where the model has them). A
+//!   formulation's `rhs` over its floor is what the runtime adds;
 //! - `partitioning`, `projection`, `baumgarte`: one `rhs` of [`StateSpace`] at a moving
 //!   state off the constraint manifold by a predictor's error (an Euler step of 1e-3
 //!   of the motion's time scale from a consistent state), alternating between two such
@@ -176,6 +184,87 @@ fn generated_solve(
     });
 }
 
+/// `{name}/floor/partitioning` and `{name}/floor/baumgarte` (see the module docs).
+fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let mut mass = vec![0.0; info.mass_pattern.len()];
+    let mut cq = vec![0.0; info.holonomic_pattern.len()];
+    let mut g = vec![0.0; info.nonholonomic_pattern.len()];
+    let mut constraints = vec![0.0; mh];
+    let (mut ct, mut bias) = (vec![0.0; mh], vec![0.0; mnh]);
+    let mut velocities = qd.to_vec();
+    let mut x = vec![0.0; n + mh + mnh];
+    let probe = model.orthogonal_projection(&cq, &g, &ct, &bias, &mut velocities);
+    if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable
+        || probe == AugmentedSolve::Unavailable
+    {
+        eprintln!("{name}: no generated solves (above the generator's budget), no floors");
+        return;
+    }
+    let rates = |ct: &mut [f64], bias: &mut [f64]| {
+        if mh > 0 && info.time.holonomic {
+            model.holonomic_rate(t, q, ct);
+        }
+        if mnh > 0 && !info.nonholonomic_homogeneous {
+            model.nonholonomic_bias(t, q, bias);
+        }
+    };
+    c.bench_function(&format!("{name}/floor/partitioning"), |b| {
+        b.iter(|| {
+            model.holonomic(black_box(t), black_box(q), &mut constraints);
+            rates(&mut ct, &mut bias);
+            velocities.copy_from_slice(black_box(qd));
+            let (forces, gamma) = x.split_at_mut(n);
+            let (gh, gnh) = gamma.split_at_mut(mh);
+            let mut outcome = AugmentedSolve::Unavailable;
+            model.dynamics_terms_corrected(
+                black_box(t),
+                black_box(q),
+                &mut velocities,
+                DynamicsTerms {
+                    holonomic: None,
+                    mass: &mut mass,
+                    forces,
+                    holonomic_jacobian: &mut cq,
+                    holonomic_gamma: gh,
+                    nonholonomic_matrix: &mut g,
+                    nonholonomic_gamma: gnh,
+                },
+                &mut |cq, g, qd| outcome = model.orthogonal_projection(cq, g, &ct, &bias, qd),
+            );
+            assert_eq!(outcome, AugmentedSolve::Solved);
+            let solved = model.augmented_solve(&mass, &cq, &g, &mut x);
+            assert_eq!(solved, AugmentedSolve::Solved);
+            black_box((&constraints, &x));
+        });
+    });
+    c.bench_function(&format!("{name}/floor/baumgarte"), |b| {
+        b.iter(|| {
+            rates(&mut ct, &mut bias);
+            let (forces, gamma) = x.split_at_mut(n);
+            let (gh, gnh) = gamma.split_at_mut(mh);
+            model.dynamics_terms(
+                black_box(t),
+                black_box(q),
+                black_box(qd),
+                DynamicsTerms {
+                    holonomic: Some(&mut constraints),
+                    mass: &mut mass,
+                    forces,
+                    holonomic_jacobian: &mut cq,
+                    holonomic_gamma: gh,
+                    nonholonomic_matrix: &mut g,
+                    nonholonomic_gamma: gnh,
+                },
+            );
+            let solved = model.augmented_solve(&mass, &cq, &g, &mut x);
+            assert_eq!(solved, AugmentedSolve::Solved);
+            black_box((&constraints, &ct, &bias, &x));
+        });
+    });
+}
+
 fn rhs(c: &mut Criterion) {
     for &(name, make, t, scale) in CASES {
         let model = make();
@@ -183,6 +272,7 @@ fn rhs(c: &mut Criterion) {
         generated(c, name, model.as_ref(), t, &q, &qd);
         terms(c, name, model.as_ref(), t, &q, &qd);
         generated_solve(c, name, model.as_ref(), t, &q, &qd);
+        floors(c, name, model.as_ref(), t, &q, &qd);
         let n = q.len();
         // The general path as before the generated solve: dense LU below the
         // crossover, sparse LU from it.
