@@ -616,6 +616,28 @@ pub trait Mechanism {
         AugmentedSolve::Unavailable
     }
 
+    /// The velocity residuals $[C_q\dot q + C_t;\ G\dot q + g]$ into `out` (length
+    /// `m_h + m_nh`) from the pattern values `cq`, `g`, the rates `ct` ($C_t$) and
+    /// `bias` ($g$) at a point and the velocities `qd`; `true` when written.
+    ///
+    /// The generator emits it for every model with constraint rows: each row's rate,
+    /// then its entries in the pattern's order, added left to right (the runtime's
+    /// row-by-row sums to the bit) as straight-line code. The default returns `false`
+    /// and leaves `out` alone (the runtime then walks the patterns itself). Allocates
+    /// nothing.
+    fn velocity_residuals(
+        &self,
+        cq: &[f64],
+        g: &[f64],
+        ct: &[f64],
+        bias: &[f64],
+        qd: &[f64],
+        out: &mut [f64],
+    ) -> bool {
+        let _ = (cq, g, ct, bias, qd, out);
+        false
+    }
+
     /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin
     /// `(x, y, z)` and then the rotation matrix to the global frame, row-major. Planar
     /// frames have `z = 0` and turn about the z axis.

@@ -662,11 +662,33 @@ impl Workspace {
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
+        self.eval_dynamics_terms_corrected_unchecked(mech, t, q, qd, constraints, correct);
+        self.check_dynamics_terms(t)
+    }
+
+    /// [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected) for the
+    /// simulation's point, without the checks: the model's (see
+    /// [`eval_dynamics_terms_unchecked`](Self::eval_dynamics_terms_unchecked)) and the
+    /// terms' (the caller checks them before anything but the model's generated solves
+    /// reads them; `correct` sees $C_q$ and $G$ unchecked, and a generated projection
+    /// declines on a non-finite one).
+    // A callback with the slices it reads and the velocities it corrects.
+    #[allow(clippy::type_complexity)]
+    #[inline]
+    pub(crate) fn eval_dynamics_terms_corrected_unchecked<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+        constraints: bool,
+        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+    ) {
+        debug_assert!(self.check_model(mech, q, Some(qd)).is_ok());
         let (terms, (ct, bias)) = self.dynamics_outputs(constraints);
         mech.dynamics_terms_corrected(t, q, qd, terms, &mut |cq, g, qd| {
             correct(cq, g, ct, bias, qd);
         });
-        self.check_dynamics_terms(t)
     }
 
     /// The finiteness checks of the dynamics terms: one branch-free pass that sums every

@@ -292,7 +292,9 @@ impl Form for Partitioned {
             })
             .map_err(SimErrorKind::from_eval)?;
             if outcome.is_none() {
-                // Not contracting: the factored projection, and the terms again.
+                // Not contracting (a non-finite C_q or G among the causes, named by the
+                // check): the factored projection, and the terms again.
+                p.check_terms(t)?;
                 p.project_velocities(t)?;
             }
         }

@@ -566,11 +566,24 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $[C_q\dot q + C_t;\ G\dot q + g]$ at the current state, into `vel` (the
-    /// functions evaluated once per $(t, q)$, the products with $\dot q$ every call).
+    /// functions evaluated once per $(t, q)$, the products with $\dot q$ every call: by
+    /// the model's generated [`Mechanism::velocity_residuals`], else by walking the
+    /// patterns).
     pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
         let info = self.info;
         let mh = info.nh();
         self.velocity_terms(t)?;
+        let ws = &self.ws;
+        if self.mech.velocity_residuals(
+            &ws.cq_values,
+            &ws.g_values,
+            &ws.ct,
+            &ws.bias,
+            &self.qd,
+            &mut self.vel,
+        ) {
+            return Ok(());
+        }
         let (holonomic, nonholonomic) = self.vel.split_at_mut(mh);
         holonomic.copy_from_slice(&self.ws.ct);
         nonholonomic.copy_from_slice(&self.ws.bias);
@@ -733,7 +746,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// The finiteness check of the held dynamics terms ([`Workspace::check_dynamics_terms`],
     /// naming the first non-finite entry), once per evaluation; terms that fail it are
     /// forgotten with what was stamped from them.
-    fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
+    pub(crate) fn check_terms(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if !self.terms_checked {
             if let Err(e) = self.ws.check_dynamics_terms(t) {
                 self.forget_terms();
@@ -769,7 +782,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// The velocities corrected by `correct(cq, g, ct, bias, qd)` with the pattern values
     /// of $C_q$, $G$ and the rates at the current $(t, q)$, then $M$, $Q$ and $\gamma$ at
     /// the corrected velocities, from one call of the model's fused evaluation
-    /// ([`Mechanism::dynamics_terms_corrected`]).
+    /// ([`Mechanism::dynamics_terms_corrected`]). The terms are not checked here: as
+    /// those of [`accelerations`](Self::accelerations), they go to the model's
+    /// generated solve, which vouches for them, and [`check_terms`](Self::check_terms)
+    /// checks them before anything else reads them (`correct` sees $C_q$ and $G$
+    /// unchecked: a generated projection declines on a non-finite entry).
     // A callback with the slices it reads and the velocities it corrects.
     #[allow(clippy::type_complexity)]
     pub fn dynamics_terms_corrected(
@@ -789,18 +806,18 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if with_c {
             self.constraints = 0;
         }
-        self.ws.eval_dynamics_terms_corrected(
+        self.ws.eval_dynamics_terms_corrected_unchecked(
             self.mech,
             t,
             &self.q,
             &mut self.qd,
             with_c,
             correct,
-        )?;
+        );
         // The velocities may have changed: a new state version, the same position.
         let (position, state) = self.versions(t);
         self.terms = state;
-        self.terms_checked = true;
+        self.terms_checked = false;
         self.jacobian = position;
         if with_c {
             self.stamp_terms_constraints(position);

@@ -940,3 +940,63 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
     eprintln!("orthogonal projection served: {served:?}");
     assert!(served.len() >= 15, "models served: {served:?}");
 }
+
+/// The generated velocity residuals (`Mechanism::velocity_residuals`) against the
+/// runtime's sums written here (each row's rate, then its entries in the pattern's
+/// order, added left to right): the same bits, on seeded states of every built-in
+/// model with constraint rows and seeded rates (the rates' terms exercised on
+/// scleronomic models too); a row with a NaN rate gives NaN there and leaves the others
+/// as they were. Every model with constraint rows has them (no budget: the sums are
+/// linear in the patterns' entries).
+#[test]
+fn the_generated_velocity_residuals_are_the_runtime_sums_to_the_bit() {
+    let mut served = 0;
+    for (k, entry) in pfaff_models::all().iter().enumerate() {
+        let model = (entry.make)();
+        let model = model.as_ref();
+        let info = model.info();
+        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        let m = mh + mnh;
+        if m == 0 {
+            continue;
+        }
+        let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
+        let mut rng = Rng::new(2900 + k as u64);
+        for (q, qd) in states(model, 3, 2800 + k as u64) {
+            let all = terms(model, 0.3, &q, &qd, false);
+            let lm = info.mass_pattern.len();
+            let (cq, rest) = all[lm + n..].split_at(hol.len());
+            let g = &rest[mh..mh + non.len()];
+            let (mut ct, bias) = (rng.vec(mh, -1.0, 1.0), rng.vec(mnh, -1.0, 1.0));
+            for poisoned in [false, true] {
+                if poisoned {
+                    if mh == 0 {
+                        continue;
+                    }
+                    ct[mh - 1] = f64::NAN;
+                }
+                let mut expected: Vec<f64> = ct.iter().chain(&bias).copied().collect();
+                for (i, c, v) in jacobian_entries(info, cq, g) {
+                    expected[i] += v * qd[c];
+                }
+                let mut got = vec![7.0; m];
+                assert!(
+                    model.velocity_residuals(cq, g, &ct, &bias, &qd, &mut got),
+                    "{}: no generated velocity residuals",
+                    entry.name
+                );
+                assert_eq!(
+                    got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    expected.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    "{}: not the runtime's sums to the bit",
+                    entry.name
+                );
+                if poisoned {
+                    assert!(got[mh - 1].is_nan(), "{}", entry.name);
+                }
+            }
+        }
+        served += 1;
+    }
+    assert!(served >= 15, "models with constraint rows: {served}");
+}

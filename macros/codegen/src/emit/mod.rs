@@ -487,6 +487,11 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         (d.c.len(), d.gb.len()),
         (&d.cq, &d.gm),
     ));
+    fns.extend(solve::velocity_residuals(
+        model.coords.len(),
+        (d.c.len(), d.gb.len()),
+        (&d.cq, &d.gm),
+    ));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();
         roots.extend(qd0);

@@ -894,49 +894,17 @@ fn orthogonal_projection(
 ) -> TokenStream {
     let dim = n + mh + mnh;
     let lit = Literal::usize_unsuffixed;
-    // Row i of a pattern: its rate, then its entries in the pattern's order.
     let mut rows = TokenStream::new();
-    for (entries, count, values, rates, first) in [
-        (cq, mh, quote!(cq), quote!(ct), n),
-        (gm, mnh, quote!(g), quote!(bias), n + mh),
-    ] {
-        for i in 0..count {
-            let li = lit(i);
-            let mut sum = quote!(#rates[#li]);
-            for (k, e) in entries
-                .iter()
-                .enumerate()
-                .filter(|(_, e)| e.row as usize == i)
-            {
-                let (k, c) = (lit(k), lit(e.col as usize));
-                sum = quote!((#sum + #values[#k] * qd[#c]));
-            }
-            let at = lit(first + i);
-            rows.extend(quote!(x[#at] = -#sum;));
-        }
+    for (i, sum) in residual_sums((mh, mnh), (cq, gm)).into_iter().enumerate() {
+        let at = lit(n + i);
+        rows.extend(quote!(x[#at] = -#sum;));
     }
-    let (cq_len, g_len, n_lit, dim_lit) = (lit(cq.len()), lit(gm.len()), lit(n), lit(dim));
-    let (mh_lit, mnh_lit) = (lit(mh), lit(mnh));
-    let g_cut = if mnh == 0 {
-        TokenStream::new()
-    } else {
-        quote!(let g = &g[..#g_len];)
-    };
-    let (bias_param, bias_cut) = if mnh == 0 {
-        (quote!(_bias), TokenStream::new())
-    } else {
-        (quote!(bias), quote!(let bias = &bias[..#mnh_lit];))
-    };
-    let (ct_param, ct_cut) = if mh == 0 {
-        (quote!(_ct), TokenStream::new())
-    } else {
-        (quote!(ct), quote!(let ct = &ct[..#mh_lit];))
-    };
-    let cq_cut = if mh == 0 {
-        TokenStream::new()
-    } else {
-        quote!(let cq = &cq[..#cq_len];)
-    };
+    let Inputs {
+        ct_param,
+        bias_param,
+        cuts,
+    } = residual_inputs((mh, mnh), (cq, gm));
+    let (n_lit, dim_lit) = (lit(n), lit(dim));
     quote! {
         fn orthogonal_projection(
             &self,
@@ -946,10 +914,7 @@ fn orthogonal_projection(
             #bias_param: &[f64],
             qd: &mut [f64],
         ) -> ::pfaff::__private::AugmentedSolve {
-            #cq_cut
-            #g_cut
-            #ct_cut
-            #bias_cut
+            #cuts
             let qd = &mut qd[..#n_lit];
             let mut x = [0.0_f64; #dim_lit];
             #rows
@@ -965,6 +930,115 @@ fn orthogonal_projection(
                 *v += d;
             }
             ::pfaff::__private::AugmentedSolve::Solved
+        }
+    }
+}
+
+/// The residual of every constraint row, $[C_q\dot q + C_t;\ G\dot q + g]$, as the
+/// expression over the slices `cq`, `g`, `ct`, `bias` and `qd`: row $i$'s rate, then its
+/// entries in the pattern's order, added left to right (the sums of the runtime's
+/// row-by-row loop, to the bit).
+fn residual_sums((mh, mnh): (usize, usize), (cq, gm): (&[Entry], &[Entry])) -> Vec<TokenStream> {
+    let lit = Literal::usize_unsuffixed;
+    let mut sums = Vec::with_capacity(mh + mnh);
+    for (entries, count, values, rates) in [
+        (cq, mh, quote!(cq), quote!(ct)),
+        (gm, mnh, quote!(g), quote!(bias)),
+    ] {
+        for i in 0..count {
+            let li = lit(i);
+            let mut sum = quote!(#rates[#li]);
+            for (k, e) in entries
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.row as usize == i)
+            {
+                let (k, c) = (lit(k), lit(e.col as usize));
+                sum = quote!((#sum + #values[#k] * qd[#c]));
+            }
+            sums.push(sum);
+        }
+    }
+    sums
+}
+
+/// The parameters `ct` and `bias` of a method reading [`residual_sums`] (underscored
+/// when the model has no such rows) and the statements that cut the input slices to
+/// the patterns' lengths (no bounds checks in the sums).
+struct Inputs {
+    ct_param: TokenStream,
+    bias_param: TokenStream,
+    cuts: TokenStream,
+}
+
+fn residual_inputs((mh, mnh): (usize, usize), (cq, gm): (&[Entry], &[Entry])) -> Inputs {
+    let lit = Literal::usize_unsuffixed;
+    let (cq_len, g_len, mh_lit, mnh_lit) = (lit(cq.len()), lit(gm.len()), lit(mh), lit(mnh));
+    let mut cuts = TokenStream::new();
+    if mh > 0 {
+        cuts.extend(quote!(let cq = &cq[..#cq_len];));
+    }
+    if mnh > 0 {
+        cuts.extend(quote!(let g = &g[..#g_len];));
+    }
+    let ct_param = if mh == 0 {
+        quote!(_ct)
+    } else {
+        cuts.extend(quote!(let ct = &ct[..#mh_lit];));
+        quote!(ct)
+    };
+    let bias_param = if mnh == 0 {
+        quote!(_bias)
+    } else {
+        cuts.extend(quote!(let bias = &bias[..#mnh_lit];));
+        quote!(bias)
+    };
+    Inputs {
+        ct_param,
+        bias_param,
+        cuts,
+    }
+}
+
+/// The trait method `velocity_residuals`, for every model with constraint rows:
+/// [`residual_sums`] stored in `out`, straight-line code where the runtime walks the
+/// patterns entry by entry (Baumgarte's shift, the velocity stage of projection and
+/// the monitors read them).
+pub fn velocity_residuals(
+    n: usize,
+    (mh, mnh): (usize, usize),
+    (cq, gm): (&[Entry], &[Entry]),
+) -> TokenStream {
+    if mh + mnh == 0 || n == 0 {
+        return TokenStream::new();
+    }
+    let lit = Literal::usize_unsuffixed;
+    let mut rows = TokenStream::new();
+    for (i, sum) in residual_sums((mh, mnh), (cq, gm)).into_iter().enumerate() {
+        let at = lit(i);
+        rows.extend(quote!(out[#at] = #sum;));
+    }
+    let Inputs {
+        ct_param,
+        bias_param,
+        cuts,
+    } = residual_inputs((mh, mnh), (cq, gm));
+    let (n_lit, m_lit) = (lit(n), lit(mh + mnh));
+    quote! {
+        fn velocity_residuals(
+            &self,
+            cq: &[f64],
+            g: &[f64],
+            #ct_param: &[f64],
+            #bias_param: &[f64],
+            qd: &[f64],
+            out: &mut [f64],
+        ) -> bool {
+            #cuts
+            let qd = &qd[..#n_lit];
+            let out = &mut out[..#m_lit];
+            #rows
+            true
         }
     }
 }
