@@ -666,15 +666,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             }
         };
         self.terms_checked = true;
+        self.solved = state;
         if stats.path == SolverPath::Redundant {
             // The redundant path scattered J at this point into the dense array.
             self.dense = position;
-        }
-        self.solved = state;
-        // Reported once, as first identified: which rows of a dependent set the
-        // pivoting names can change along the motion, the redundancy does not.
-        if self.redundant.is_empty() {
-            self.redundant.extend(self.dynamics.redundant_constraints());
+            // Reported once, as first identified: which rows of a dependent set the
+            // pivoting names can change along the motion, the redundancy does not
+            // (only this path finds rows redundant).
+            if self.redundant.is_empty() {
+                self.redundant.extend(self.dynamics.redundant_constraints());
+            }
         }
         Ok(())
     }
