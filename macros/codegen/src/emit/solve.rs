@@ -1000,10 +1000,10 @@ fn residual_inputs((mh, mnh): (usize, usize), (cq, gm): (&[Entry], &[Entry])) ->
     }
 }
 
-/// The trait method `velocity_residuals`, for every model with constraint rows:
-/// [`residual_sums`] stored in `out`, straight-line code where the runtime walks the
-/// patterns entry by entry (Baumgarte's shift, the velocity stage of projection and
-/// the monitors read them).
+/// The trait method `velocity_residuals`, for every model with constraint rows: each
+/// row's residual sum (its rate, then its entries in the pattern's order) stored in
+/// `out`, straight-line code where the runtime walks the patterns entry by entry
+/// (Baumgarte's shift, the velocity stage of projection and the monitors read them).
 pub fn velocity_residuals(
     n: usize,
     (mh, mnh): (usize, usize),
