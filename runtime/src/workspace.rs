@@ -669,9 +669,10 @@ impl Workspace {
     /// [`eval_dynamics_terms_corrected`](Self::eval_dynamics_terms_corrected) for the
     /// simulation's point, without the checks: the model's (see
     /// [`eval_dynamics_terms_unchecked`](Self::eval_dynamics_terms_unchecked)) and the
-    /// terms' (the caller checks them before anything but the model's generated solves
-    /// reads them; `correct` sees $C_q$ and $G$ unchecked, and a generated projection
-    /// declines on a non-finite one).
+    /// terms'. `correct` reads $C_q$ and $G$ unchecked (a generated projection declines
+    /// on a non-finite entry; the runtime's iteration may leave non-finite velocities
+    /// and report no convergence), and the caller checks the terms before anything
+    /// else but the model's generated solve reads them.
     // A callback with the slices it reads and the velocities it corrects.
     #[allow(clippy::type_complexity)]
     #[inline]

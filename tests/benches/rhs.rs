@@ -217,7 +217,7 @@ fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64
             model.holonomic(black_box(t), black_box(q), &mut constraints);
             // The terms are evaluated at positions corrected from C, so they wait for
             // it: the dependence without the correction's work (a zero update).
-            let wait = 0.0 * constraints[0];
+            let wait = constraints.first().map_or(0.0, |c| 0.0 * c);
             for (c, &qj) in corrected.iter_mut().zip(q) {
                 *c = qj + wait;
             }

@@ -211,8 +211,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// monitors read $C$ next ([`OdeSystem::step_end_next`](crate::ode::OdeSystem)).
     pub constraints_next: bool,
     /// Whether the dynamics terms held (stamp `terms`) passed their finiteness check:
-    /// [`dynamics_terms_at`](Self::dynamics_terms_at) evaluates them unchecked, and
-    /// [`accelerations`](Self::accelerations) lets the generated solve vouch for them.
+    /// [`dynamics_terms_at`](Self::dynamics_terms_at) and
+    /// [`dynamics_terms_corrected`](Self::dynamics_terms_corrected) evaluate them
+    /// unchecked, and [`accelerations`](Self::accelerations) lets the generated solve
+    /// vouch for them.
     terms_checked: bool,
     /// $[\Delta q; \mu]$ of [`project_in_mass_metric`](Self::project_in_mass_metric).
     solution_scratch: Vec<f64>,
