@@ -160,32 +160,51 @@ fn generated_solve(
         eprintln!("{name}: no generated solve (above the generator's budget)");
         return;
     }
-    c.bench_function(&format!("{name}/generated+solve"), |b| {
-        b.iter(|| {
-            let (forces, gamma) = x.split_at_mut(n);
-            let (gh, gnh) = gamma.split_at_mut(mh);
-            model.dynamics_terms(
-                black_box(t),
-                black_box(q),
-                black_box(qd),
-                DynamicsTerms {
-                    holonomic: None,
-                    mass: &mut mass,
-                    forces,
-                    holonomic_jacobian: &mut cq,
-                    holonomic_gamma: gh,
-                    nonholonomic_matrix: &mut g,
-                    nonholonomic_gamma: gnh,
-                },
-            );
-            let outcome = model.augmented_solve(&mass, &cq, &g, &mut x);
-            assert_eq!(outcome, AugmentedSolve::Solved);
-            black_box(&x);
+    // Baumgarte's floor: the terms with C (and the rates, where the model has them).
+    let mut constraints = vec![0.0; mh];
+    let (mut ct, mut bias) = (vec![0.0; mh], vec![0.0; mnh]);
+    for (label, with_c) in [("generated+solve", false), ("floor/baumgarte", true)] {
+        c.bench_function(&format!("{name}/{label}"), |b| {
+            b.iter(|| {
+                if with_c {
+                    rates(model, t, q, &mut ct, &mut bias);
+                }
+                let (forces, gamma) = x.split_at_mut(n);
+                let (gh, gnh) = gamma.split_at_mut(mh);
+                model.dynamics_terms(
+                    black_box(t),
+                    black_box(q),
+                    black_box(qd),
+                    DynamicsTerms {
+                        holonomic: with_c.then_some(&mut constraints[..]),
+                        mass: &mut mass,
+                        forces,
+                        holonomic_jacobian: &mut cq,
+                        holonomic_gamma: gh,
+                        nonholonomic_matrix: &mut g,
+                        nonholonomic_gamma: gnh,
+                    },
+                );
+                let outcome = model.augmented_solve(&mass, &cq, &g, &mut x);
+                assert_eq!(outcome, AugmentedSolve::Solved);
+                black_box((&constraints, &ct, &bias, &x));
+            });
         });
-    });
+    }
 }
 
-/// `{name}/floor/partitioning` and `{name}/floor/baumgarte` (see the module docs).
+/// The rates $C_t$ and $g$ at `(t, q)` into `ct` and `bias`, where the model has them.
+fn rates(model: &dyn Mechanism, t: f64, q: &[f64], ct: &mut [f64], bias: &mut [f64]) {
+    let info = model.info();
+    if info.nh() > 0 && info.time.holonomic {
+        model.holonomic_rate(t, q, ct);
+    }
+    if info.nnh() > 0 && !info.nonholonomic_homogeneous {
+        model.nonholonomic_bias(t, q, bias);
+    }
+}
+
+/// `{name}/floor/partitioning` (see the module docs).
 fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64], qd: &[f64]) {
     let info = model.info();
     let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
@@ -200,17 +219,9 @@ fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64
     if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable
         || probe == AugmentedSolve::Unavailable
     {
-        eprintln!("{name}: no generated solves (above the generator's budget), no floors");
+        eprintln!("{name}: no generated solves (above the generator's budget), no floor");
         return;
     }
-    let rates = |ct: &mut [f64], bias: &mut [f64]| {
-        if mh > 0 && info.time.holonomic {
-            model.holonomic_rate(t, q, ct);
-        }
-        if mnh > 0 && !info.nonholonomic_homogeneous {
-            model.nonholonomic_bias(t, q, bias);
-        }
-    };
     let mut corrected = q.to_vec();
     c.bench_function(&format!("{name}/floor/partitioning"), |b| {
         b.iter(|| {
@@ -221,7 +232,7 @@ fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64
             for (c, &qj) in corrected.iter_mut().zip(q) {
                 *c = qj + wait;
             }
-            rates(&mut ct, &mut bias);
+            rates(model, t, q, &mut ct, &mut bias);
             velocities.copy_from_slice(black_box(qd));
             let (forces, gamma) = x.split_at_mut(n);
             let (gh, gnh) = gamma.split_at_mut(mh);
@@ -245,30 +256,6 @@ fn floors(c: &mut Criterion, name: &str, model: &dyn Mechanism, t: f64, q: &[f64
             let solved = model.augmented_solve(&mass, &cq, &g, &mut x);
             assert_eq!(solved, AugmentedSolve::Solved);
             black_box((&constraints, &x));
-        });
-    });
-    c.bench_function(&format!("{name}/floor/baumgarte"), |b| {
-        b.iter(|| {
-            rates(&mut ct, &mut bias);
-            let (forces, gamma) = x.split_at_mut(n);
-            let (gh, gnh) = gamma.split_at_mut(mh);
-            model.dynamics_terms(
-                black_box(t),
-                black_box(q),
-                black_box(qd),
-                DynamicsTerms {
-                    holonomic: Some(&mut constraints),
-                    mass: &mut mass,
-                    forces,
-                    holonomic_jacobian: &mut cq,
-                    holonomic_gamma: gh,
-                    nonholonomic_matrix: &mut g,
-                    nonholonomic_gamma: gnh,
-                },
-            );
-            let solved = model.augmented_solve(&mass, &cq, &g, &mut x);
-            assert_eq!(solved, AugmentedSolve::Solved);
-            black_box((&constraints, &ct, &bias, &x));
         });
     });
 }

@@ -856,6 +856,43 @@ fn the_orthogonal_solve_meets_its_defining_equations() {
     assert!(served.len() >= 15, "models served: {served:?}");
 }
 
+/// A seeded point of a model with constraint rows for the velocity-level tests: the
+/// pattern values of $C_q$ and $G$ at a seeded state, seeded rates $C_t$ and $g$ (so
+/// that the rates' terms are exercised on scleronomic models too), and the state's
+/// velocities.
+struct VelocitySample {
+    cq: Vec<f64>,
+    g: Vec<f64>,
+    ct: Vec<f64>,
+    bias: Vec<f64>,
+    qd: Vec<f64>,
+}
+
+/// `count` [`VelocitySample`]s of `model` from the seeds `seed` (states) and `seed + 100`
+/// (rates).
+fn velocity_samples(model: &dyn Mechanism, count: usize, seed: u64) -> Vec<VelocitySample> {
+    let info = model.info();
+    let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+    let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
+    let mut rng = Rng::new(seed + 100);
+    states(model, count, seed)
+        .into_iter()
+        .map(|(q, qd)| {
+            let all = terms(model, 0.3, &q, &qd, false);
+            let lm = info.mass_pattern.len();
+            let (cq, rest) = all[lm + n..].split_at(hol.len());
+            let g = &rest[mh..mh + non.len()];
+            VelocitySample {
+                cq: cq.to_vec(),
+                g: g.to_vec(),
+                ct: rng.vec(mh, -1.0, 1.0),
+                bias: rng.vec(mnh, -1.0, 1.0),
+                qd,
+            }
+        })
+        .collect()
+}
+
 /// The generated orthogonal projection (`Mechanism::orthogonal_projection`: the
 /// residuals $r = J\dot q + [C_t; g]$ over the patterns, the orthogonal solve with
 /// $[0; -r]$, $\dot q \mathrel{+}= \Delta$) against the same three steps written here
@@ -877,15 +914,16 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
         if m == 0 {
             continue;
         }
-        let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
-        let mut rng = Rng::new(1900 + k as u64);
         let mut solved_here = false;
-        for (q, qd) in states(model, 4, 1800 + k as u64) {
-            let all = terms(model, 0.3, &q, &qd, false);
-            let lm = info.mass_pattern.len();
-            let (cq, rest) = all[lm + n..].split_at(hol.len());
-            let g = &rest[mh..mh + non.len()];
-            let (ct, bias) = (rng.vec(mh, -1.0, 1.0), rng.vec(mnh, -1.0, 1.0));
+        for sample in velocity_samples(model, 4, 1800 + k as u64) {
+            let VelocitySample {
+                cq,
+                g,
+                ct,
+                bias,
+                qd,
+            } = sample;
+            let (cq, g) = (&cq[..], &g[..]);
             // The runtime's way: residuals row by row, then the solve.
             let mut x = vec![0.0; n + m];
             let mut residual: Vec<f64> = ct.iter().chain(&bias).copied().collect();
@@ -955,19 +993,20 @@ fn the_generated_velocity_residuals_are_the_runtime_sums_to_the_bit() {
         let model = (entry.make)();
         let model = model.as_ref();
         let info = model.info();
-        let (n, mh, mnh) = (info.nq(), info.nh(), info.nnh());
+        let (mh, mnh) = (info.nh(), info.nnh());
         let m = mh + mnh;
         if m == 0 {
             continue;
         }
-        let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
-        let mut rng = Rng::new(2900 + k as u64);
-        for (q, qd) in states(model, 3, 2800 + k as u64) {
-            let all = terms(model, 0.3, &q, &qd, false);
-            let lm = info.mass_pattern.len();
-            let (cq, rest) = all[lm + n..].split_at(hol.len());
-            let g = &rest[mh..mh + non.len()];
-            let (mut ct, bias) = (rng.vec(mh, -1.0, 1.0), rng.vec(mnh, -1.0, 1.0));
+        for sample in velocity_samples(model, 3, 2800 + k as u64) {
+            let VelocitySample {
+                cq,
+                g,
+                mut ct,
+                bias,
+                qd,
+            } = sample;
+            let (cq, g) = (&cq[..], &g[..]);
             for poisoned in [false, true] {
                 if poisoned {
                     if mh == 0 {
