@@ -877,9 +877,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.constraints_with_jacobian_values(t)?;
         self.velocity_residuals(t)?;
         let c = self.ws.constraints();
-        for (i, s) in shift.iter_mut().enumerate() {
-            let position = if i < mh { beta * beta * c[i] } else { 0.0 };
-            *s = -2.0 * alpha * self.vel[i] - position;
+        // -2α v - β²C on the holonomic rows, -2α v on the others (v - 0 is v, to the
+        // bit, the sign of a zero included).
+        let (damping, stiffness) = (-2.0 * alpha, beta * beta);
+        let (holonomic, nonholonomic) = shift.split_at_mut(mh);
+        let (vel_h, vel_nh) = self.vel.split_at(mh);
+        for ((s, v), c) in holonomic.iter_mut().zip(vel_h).zip(c) {
+            *s = damping * v - stiffness * c;
+        }
+        for (s, v) in nonholonomic.iter_mut().zip(vel_nh) {
+            *s = damping * v;
         }
         Ok(())
     }
