@@ -629,7 +629,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if self.solved == state {
             return Ok(());
         }
-        let with_c = self.constraints_with_terms || std::mem::take(&mut self.constraints_next);
+        let with_c = self.constraints_asked();
         self.dynamics_terms_at(t, (position, state), with_c)?;
         self.factorizations += 1;
         // A model with redundant constraints gives the solve the velocity residuals,
@@ -680,6 +680,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             }
         }
         Ok(())
+    }
+
+    /// Whether the next evaluation of the dynamics terms writes $C$ too: always with
+    /// [`constraints_with_terms`](Self::constraints_with_terms), once after
+    /// [`constraints_next`](Self::constraints_next) (cleared here).
+    fn constraints_asked(&mut self) -> bool {
+        self.constraints_with_terms || std::mem::take(&mut self.constraints_next)
     }
 
     /// [`velocity_residuals`](Self::velocity_residuals) for the solve of a model with
@@ -802,8 +809,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
         }
-        let asked = self.constraints_with_terms || std::mem::take(&mut self.constraints_next);
-        let with_c = asked && self.constraints != at;
+        let with_c = self.constraints_asked() && self.constraints != at;
         self.jacobian = 0;
         self.terms = 0;
         if with_c {
@@ -1274,6 +1280,16 @@ mod tests {
         }
     }
 
+    /// A point of [`Circle`] with the default parameters.
+    fn circle_point(mech: &Circle) -> Point<'_, Circle> {
+        Point::new(mech, DynamicsParams::default(), KinematicsParams::default()).expect("a point")
+    }
+
+    /// $C = x^2 + y^2 - 1$ in closed form.
+    fn circle(q: &[f64]) -> f64 {
+        q[0] * q[0] + q[1] * q[1] - 1.0
+    }
+
     /// `add_products` is the scatter `out[r] += v * x[c]` bit for bit, for patterns by
     /// rows, with rows left and entered again, and empty.
     #[test]
@@ -1313,13 +1329,7 @@ mod tests {
     /// separate functions.
     #[test]
     fn constraints_come_with_the_jacobian_when_both_were_read() {
-        let mech = Circle;
-        let mut p = Point::new(
-            &mech,
-            DynamicsParams::default(),
-            KinematicsParams::default(),
-        )
-        .expect("a point");
+        let mut p = circle_point(&Circle);
         // Reading C only, at three iterates.
         p.set_state(&[1.2, 0.1, 0.0, 0.0]);
         for k in 0..3 {
@@ -1359,41 +1369,34 @@ mod tests {
     /// $x^2 + y^2 - 1$.
     #[test]
     fn constraints_come_with_the_terms_only_when_asked_for() {
-        let mech = Circle;
-        let mut p = Point::new(
-            &mech,
-            DynamicsParams::default(),
-            KinematicsParams::default(),
-        )
-        .expect("a point");
-        let circle = |p: &Point<'_, Circle>| p.q[0] * p.q[0] + p.q[1] * p.q[1] - 1.0;
+        let mut p = circle_point(&Circle);
         p.set_state(&[1.2, 0.1, 0.3, -0.2]);
         p.constraints(0.0).expect("C");
         assert_eq!(counts(&p), (1, 0, 0));
         // Terms at a new point without C: C there is evaluated when read.
         p.q[0] = 1.1;
         p.dynamics_terms(0.0).expect("terms");
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (2, 0, 0));
         // Asked for with every evaluation of the terms: read at no further cost.
         p.constraints_with_terms = true;
         p.q[1] = 0.2;
         p.dynamics_terms(0.0).expect("terms");
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (2, 0, 0));
         // Baumgarte's request, at a new point and then with the terms held.
         p.constraints_with_terms = false;
         p.q[0] = 1.05;
         p.dynamics_terms_and_constraints(0.0).expect("terms and C");
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (2, 0, 0));
         p.q[1] = 0.25;
         p.dynamics_terms(0.0).expect("terms");
         p.dynamics_terms_and_constraints(0.0).expect("C alone");
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (3, 0, 0));
     }
@@ -1403,24 +1406,17 @@ mod tests {
     /// the evaluation after it leaves $C$ to be evaluated where it is read.
     #[test]
     fn constraints_come_with_the_next_terms_once() {
-        let mech = Circle;
-        let mut p = Point::new(
-            &mech,
-            DynamicsParams::default(),
-            KinematicsParams::default(),
-        )
-        .expect("a point");
-        let circle = |p: &Point<'_, Circle>| p.q[0] * p.q[0] + p.q[1] * p.q[1] - 1.0;
+        let mut p = circle_point(&Circle);
         p.set_state(&[1.2, 0.1, 0.3, -0.2]);
         p.constraints_next = true;
         p.accelerations(0.0, None).expect("accelerations");
         assert!(!p.constraints_next);
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (0, 0, 0));
         p.set_state(&[1.1, 0.2, 0.3, -0.2]);
         p.accelerations(0.0, None).expect("accelerations");
-        let expected = circle(&p);
+        let expected = circle(&p.q);
         assert_eq!(p.constraints(0.0).expect("C")[0], expected);
         assert_eq!(counts(&p), (1, 0, 0));
     }
