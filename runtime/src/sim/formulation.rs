@@ -286,17 +286,20 @@ impl Form for Partitioned {
             let (mech, info, distance) = (p.mech, p.info, self.chart.distance(&p.q));
             let chart = &mut self.chart;
             let mut outcome = None;
-            p.dynamics_terms_corrected(t, &mut |cq, g, ct, bias, qd| {
-                let terms = VelocityTerms { cq, g, ct, bias };
-                outcome = chart.project_velocities(mech, info, terms, distance, qd, KAPPA);
-            })
-            .map_err(SimErrorKind::from_eval)?;
-            if outcome.is_none() {
-                // Not contracting (a non-finite C_q or G among the causes, named by the
-                // check): the factored projection, and the terms again.
-                p.check_terms(t)?;
-                p.project_velocities(t)?;
+            let versions = p
+                .dynamics_terms_corrected(t, &mut |cq, g, ct, bias, qd| {
+                    let terms = VelocityTerms { cq, g, ct, bias };
+                    outcome = chart.project_velocities(mech, info, terms, distance, qd, KAPPA);
+                })
+                .map_err(SimErrorKind::from_eval)?;
+            if outcome.is_some() {
+                // The state is the one the terms were evaluated at.
+                return p.accelerations_with(t, versions, None);
             }
+            // Not contracting (a non-finite C_q or G among the causes, named by the
+            // check): the factored projection, and the terms again.
+            p.check_terms(t)?;
+            p.project_velocities(t)?;
         }
         p.accelerations(t, None)
     }
@@ -479,11 +482,7 @@ impl Form for Stabilized {
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
-        // The fused terms first: the shift's C and C_q come with them.
-        p.dynamics_terms_and_constraints(t)?;
-        p.baumgarte_shift(t, self.alpha, self.beta, &mut self.shift)
-            .map_err(SimErrorKind::from_eval)?;
-        p.accelerations(t, Some(&self.shift))
+        p.stabilized_accelerations(t, self.alpha, self.beta, &mut self.shift)
     }
 
     fn keep<M: Mechanism + ?Sized>(

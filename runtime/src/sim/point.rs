@@ -559,6 +559,11 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// (the chart's).
     pub fn velocity_terms(&mut self, t: f64) -> Result<(), EvalError> {
         let at = self.position(t);
+        self.velocity_terms_at(t, at)
+    }
+
+    /// [`velocity_terms`](Self::velocity_terms) at the current $(t, q)$ of version `at`.
+    fn velocity_terms_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         self.jacobian_values_at(t, at)?;
         if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
@@ -572,9 +577,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// the model's generated [`Mechanism::velocity_residuals`], else by walking the
     /// patterns).
     pub fn velocity_residuals(&mut self, t: f64) -> Result<(), EvalError> {
+        let at = self.position(t);
+        self.velocity_residuals_at(t, at)
+    }
+
+    /// [`velocity_residuals`](Self::velocity_residuals) at the current state, whose
+    /// $(t, q)$ is of version `at`.
+    fn velocity_residuals_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         let info = self.info;
         let mh = info.nh();
-        self.velocity_terms(t)?;
+        self.velocity_terms_at(t, at)?;
         let ws = &self.ws;
         if self.mech.velocity_residuals(
             &ws.cq_values,
@@ -625,10 +637,32 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// of the model's fused evaluation.
     pub fn accelerations(&mut self, t: f64, shift: Option<&[f64]>) -> Result<(), SimErrorKind> {
         // A shift depends on the state only, so (t, q, q̇) identifies the solution.
-        let (position, state) = self.versions(t);
-        if self.solved == state {
+        let versions = self.versions(t);
+        self.accelerations_with(t, versions, shift)
+    }
+
+    /// [`accelerations`](Self::accelerations) at the current state, whose versions
+    /// `(position, state)` the caller has just taken (no change of the state since).
+    pub(crate) fn accelerations_with(
+        &mut self,
+        t: f64,
+        versions: (Stamp, Stamp),
+        shift: Option<&[f64]>,
+    ) -> Result<(), SimErrorKind> {
+        if self.solved == versions.1 {
             return Ok(());
         }
+        self.accelerations_at(t, versions, shift)
+    }
+
+    /// [`accelerations`](Self::accelerations) at the current state, of versions
+    /// `(position, state)`, not solved at yet.
+    fn accelerations_at(
+        &mut self,
+        t: f64,
+        (position, state): (Stamp, Stamp),
+        shift: Option<&[f64]>,
+    ) -> Result<(), SimErrorKind> {
         let with_c = self.constraints_asked();
         self.dynamics_terms_at(t, (position, state), with_c)?;
         self.factorizations += 1;
@@ -707,16 +741,28 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         self.check_terms(t)
     }
 
-    /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current $(t, q)$: from
-    /// the same call when neither is held (the generated code computes $C$ from the
-    /// sines it already has), [`constraints`](Self::constraints) when the terms are.
-    /// For callers that read $C$ at every point (Baumgarte's shift), which go on to
-    /// [`accelerations`](Self::accelerations): the terms are left unchecked for its
-    /// solve to vouch for (a non-finite term reaches the solution through the solve's
-    /// matrix or, by the shift, its right-hand side, and the check then names it); a
-    /// non-finite $C$ is not stamped, so it is evaluated again and named here.
-    pub fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
+    /// [`dynamics_terms_and_constraints_at`](Self::dynamics_terms_and_constraints_at)
+    /// at the current state's versions.
+    #[cfg(test)]
+    fn dynamics_terms_and_constraints(&mut self, t: f64) -> Result<(), SimErrorKind> {
         let versions = self.versions(t);
+        self.dynamics_terms_and_constraints_at(t, versions)
+    }
+
+    /// [`dynamics_terms`](Self::dynamics_terms) and $C$ at the current state, of
+    /// versions `(position, state)`: from the same call when neither is held (the
+    /// generated code computes $C$ from the sines it already has),
+    /// [`constraints`](Self::constraints) when the terms are. For callers that read $C$
+    /// at every point (Baumgarte's shift), which go on to the solve: the terms are left
+    /// unchecked for it to vouch for (a non-finite term reaches the solution through
+    /// the solve's matrix or, by the shift, its right-hand side, and the check then
+    /// names it); a non-finite $C$ is not stamped, so it is evaluated again and named
+    /// here.
+    fn dynamics_terms_and_constraints_at(
+        &mut self,
+        t: f64,
+        versions: (Stamp, Stamp),
+    ) -> Result<(), SimErrorKind> {
         self.dynamics_terms_at(t, versions, true)?;
         if self.constraints != versions.0 {
             self.constraints(t).map_err(SimErrorKind::from_eval)?;
@@ -796,14 +842,16 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// those of [`accelerations`](Self::accelerations), they go to the model's
     /// generated solve, which vouches for them, and [`check_terms`](Self::check_terms)
     /// checks them before anything else reads them (`correct` sees $C_q$ and $G$
-    /// unchecked: a generated projection declines on a non-finite entry).
+    /// unchecked: a generated projection declines on a non-finite entry). Returns the
+    /// versions of the corrected state, for
+    /// [`accelerations_with`](Self::accelerations_with).
     // A callback with the slices it reads and the velocities it corrects.
     #[allow(clippy::type_complexity)]
     pub fn dynamics_terms_corrected(
         &mut self,
         t: f64,
         correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
-    ) -> Result<(), EvalError> {
+    ) -> Result<(Stamp, Stamp), EvalError> {
         let at = self.position(t);
         if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
@@ -831,7 +879,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         if with_c {
             self.stamp_terms_constraints(position);
         }
-        Ok(())
+        Ok((position, state))
     }
 
     /// $\ddot q$ from $M\ddot q = Q$ at the current state (Cholesky of the dense $M$),
@@ -870,18 +918,42 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// The Baumgarte shift $s = -2\alpha [C_q\dot q + C_t; G\dot q + g] - \beta^2 [C; 0]$
-    /// at the current state, into `shift`.
-    pub fn baumgarte_shift(
+    /// $\ddot q$ and $\lambda$ at the current state with Baumgarte's shift of $\gamma$
+    /// (see [`accelerations`](Self::accelerations)), computed into `shift`: the terms
+    /// with $C$ from one fused call
+    /// ([`dynamics_terms_and_constraints_at`](Self::dynamics_terms_and_constraints_at)),
+    /// the shift from them, the solve. The state's versions are checked once for the
+    /// three, which read the same $(t, q, \dot q)$.
+    pub fn stabilized_accelerations(
         &mut self,
         t: f64,
         alpha: f64,
         beta: f64,
         shift: &mut [f64],
+    ) -> Result<(), SimErrorKind> {
+        let versions = self.versions(t);
+        if self.solved == versions.1 {
+            return Ok(());
+        }
+        self.dynamics_terms_and_constraints_at(t, versions)?;
+        self.baumgarte_shift_at(t, versions.0, alpha, beta, shift)
+            .map_err(SimErrorKind::from_eval)?;
+        self.accelerations_at(t, versions, Some(shift))
+    }
+
+    /// The Baumgarte shift $s = -2\alpha [C_q\dot q + C_t; G\dot q + g] - \beta^2 [C; 0]$
+    /// at the current state, whose $(t, q)$ is of version `at`, into `shift`.
+    fn baumgarte_shift_at(
+        &mut self,
+        t: f64,
+        at: Stamp,
+        alpha: f64,
+        beta: f64,
+        shift: &mut [f64],
     ) -> Result<(), EvalError> {
         let mh = self.info.nh();
-        self.constraints_with_jacobian_values(t)?;
-        self.velocity_residuals(t)?;
+        self.constraints_with_jacobian_values_at(t, at)?;
+        self.velocity_residuals_at(t, at)?;
         let c = self.ws.constraints();
         // -2α v - β²C on the holonomic rows, -2α v on the others (v - 0 is v, to the
         // bit, the sign of a zero included).
@@ -1364,7 +1436,7 @@ mod tests {
     /// $C$ comes with the dynamics terms only when asked for, and is never stale: terms
     /// evaluated without it leave the $C$ held at another point to be evaluated anew
     /// where it is read; with [`Point::constraints_with_terms`] (and for Baumgarte's
-    /// [`Point::dynamics_terms_and_constraints`]) the terms' call writes it, and reading
+    /// [`Point::dynamics_terms_and_constraints_at`]) the terms' call writes it, and reading
     /// it at the same point evaluates nothing more. Values against the closed form
     /// $x^2 + y^2 - 1$.
     #[test]
