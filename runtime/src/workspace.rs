@@ -510,22 +510,29 @@ impl Workspace {
         self.eval_nonholonomic_matrix(mech, t, q)
     }
 
-    /// Evaluates $C_t$ and $g$.
+    /// Evaluates $C_t$ and $g$ (nothing for a model with neither: both stay the zeros
+    /// of the allocation).
     pub fn eval_rates<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
-        self.check_model(mech, q, None)?;
         let info = self.info;
-        if info.nh() > 0 && info.time.holonomic {
+        let holonomic = info.nh() > 0 && info.time.holonomic;
+        let nonholonomic = info.nnh() > 0 && !info.nonholonomic_homogeneous;
+        if !(holonomic || nonholonomic) {
+            // Both zero, as allocated: only this writes them.
+            return Ok(());
+        }
+        self.check_model(mech, q, None)?;
+        if holonomic {
             mech.holonomic_rate(t, q, &mut self.ct);
             check_finite(Quantity::HolonomicRate, t, &self.ct)?;
         } else {
             self.ct.fill(0.0);
         }
-        if info.nnh() > 0 && !info.nonholonomic_homogeneous {
+        if nonholonomic {
             mech.nonholonomic_bias(t, q, &mut self.bias);
             check_finite(Quantity::NonholonomicBias, t, &self.bias)?;
         } else {

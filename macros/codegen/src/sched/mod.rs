@@ -153,11 +153,12 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
     for r in roots {
         uses[r.index()] += 1;
     }
+    let inline = inline_arguments(g, &partner, &angle_sums, &uses);
     let mut temp_of = vec![None; g.len()];
     let mut lets = Vec::new();
     for &id in &order {
         let leaf = matches!(g.node(id), Node::Const(_) | Node::Var(_));
-        if !leaf && (uses[id.index()] >= 2 || partner.contains_key(&id)) {
+        if !leaf && !inline.contains(&id) && (uses[id.index()] >= 2 || partner.contains_key(&id)) {
             temp_of[id.index()] = Some(lets.len());
             lets.push(id);
         }
@@ -166,7 +167,7 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
         .values()
         .flat_map(|(r, _)| r.iter().map(|r| r.first))
         .collect();
-    let twins = twins(g, &lets, &temp_of, &partner, &angle_sums);
+    let twins = twins(g, &lets, &temp_of, &partner, &angle_sums, &inline);
     Program {
         vars,
         lets,
@@ -180,15 +181,57 @@ pub fn schedule_with(g: &Graph, roots: &[ExprId], slots: &[Range<u32>]) -> Progr
     }
 }
 
+/// The arguments of sine–cosine pairs (not defined from a sum's pairs) that are sums
+/// or products of variables and constants read by the pair alone, with no other node
+/// in them read twice: printed inline in the pair's call rather than bound to a
+/// temporary, they read only variables, so they are available wherever a call of
+/// `sin_cos2` defines their pair with another (a joint's absolute angle as the sum of
+/// relative angles, `2 q`).
+fn inline_arguments(
+    g: &Graph,
+    partner: &HashMap<ExprId, ExprId>,
+    angle_sums: &HashMap<ExprId, AngleSum>,
+    uses: &[u32],
+) -> BTreeSet<ExprId> {
+    // Leaves, or sums and products of them and of such nodes read once.
+    fn of_variables(g: &Graph, id: ExprId, uses: &[u32]) -> bool {
+        match g.node(id) {
+            Node::Const(_) | Node::Var(_) => true,
+            Node::Add(a) | Node::Mul(a) => a
+                .iter()
+                .all(|&x| is_leaf(g, x) || (uses[x.index()] == 1 && of_variables(g, x, uses))),
+            _ => false,
+        }
+    }
+    fn is_leaf(g: &Graph, id: ExprId) -> bool {
+        matches!(g.node(id), Node::Const(_) | Node::Var(_))
+    }
+    partner
+        .keys()
+        .filter(|id| !angle_sums.contains_key(id))
+        .filter_map(|&id| match g.node(id) {
+            Node::Call(Func::Sin, u) => Some(*u),
+            _ => None,
+        })
+        .filter(|&u| {
+            matches!(g.node(u), Node::Add(_) | Node::Mul(_))
+                && uses[u.index()] == 2
+                && of_variables(g, u, uses)
+        })
+        .collect()
+}
+
 /// [`Program::twins`]: the defining members of the sine–cosine pairs whose argument is
-/// a variable (read at the top of the function, so available wherever the earlier of
-/// two is defined), two by two in schedule order, each mapped to the other.
+/// a variable or one of the [`inline_arguments`] (read at the top of the function or
+/// computed from what is, so available wherever the earlier of two is defined), two by
+/// two in schedule order, each mapped to the other.
 fn twins(
     g: &Graph,
     lets: &[ExprId],
     temp_of: &[Option<usize>],
     partner: &HashMap<ExprId, ExprId>,
     angle_sums: &HashMap<ExprId, AngleSum>,
+    inline: &BTreeSet<ExprId>,
 ) -> HashMap<ExprId, ExprId> {
     let defining = lets.iter().enumerate().filter_map(|(k, &id)| {
         let other = *partner.get(&id)?;
@@ -197,7 +240,8 @@ fn twins(
             Node::Call(Func::Sin | Func::Cos, u) => *u,
             _ => return None,
         };
-        (first && !angle_sums.contains_key(&id) && matches!(g.node(u), Node::Var(_))).then_some(id)
+        let available = matches!(g.node(u), Node::Var(_)) || inline.contains(&u);
+        (first && !angle_sums.contains_key(&id) && available).then_some(id)
     });
     let defining: Vec<ExprId> = defining.collect();
     let mut twins = HashMap::new();
@@ -353,9 +397,11 @@ mod tests {
         assert_eq!(p.partner.get(&ss), Some(&cs));
     }
 
-    /// The pairs of variables go two by two into one `sin_cos2` (the earlier defines
-    /// both), an odd one out stays a `sin_cos`, a pair of an expression or of a sum of
-    /// angles is never a twin, and a twin is needed with its twin.
+    /// The pairs of variables, and of sums and products of variables read by the pair
+    /// alone (printed inline, with no temporary), go two by two into one `sin_cos2`
+    /// (the earlier defines both); an odd one out stays a `sin_cos`, a pair of an
+    /// expression read elsewhere too or of a sum of angles is never a twin, and a twin
+    /// is needed with its twin.
     #[test]
     fn pairs_of_variables_are_twinned_in_schedule_order() {
         let mut g = Graph::new();
@@ -367,9 +413,13 @@ mod tests {
         let two = g.constant(2.0);
         let doubled = g.mul(vec![two, v[2]]);
         let (sx, cx) = pair(&mut g, doubled);
+        let three = g.constant(3.0);
+        let tripled = g.mul(vec![three, v[2]]);
+        let (st, ct) = pair(&mut g, tripled);
         let sum = g.add(vec![v[0], v[1]]);
         let (ss, cs) = pair(&mut g, sum);
-        let p = schedule(&g, &[s0, c0, s1, c1, s2, c2, sx, cx, ss, cs]);
+        let roots = [s0, c0, s1, c1, s2, c2, sx, cx, st, ct, tripled, ss, cs];
+        let p = schedule(&g, &roots);
         let defining = |s: ExprId, c: ExprId| {
             if p.temp(s) < p.temp(c) {
                 s
@@ -378,10 +428,15 @@ mod tests {
             }
         };
         let (d0, d1, d2) = (defining(s0, c0), defining(s1, c1), defining(s2, c2));
+        let dx = defining(sx, cx);
         assert_eq!(p.twins.get(&d0), Some(&d1));
         assert_eq!(p.twins.get(&d1), Some(&d0));
-        assert_eq!(p.twins.len(), 2, "{:?}", p.twins);
-        for id in [d2, sx, cx, ss, cs] {
+        assert_eq!(p.twins.get(&d2), Some(&dx));
+        assert_eq!(p.twins.get(&dx), Some(&d2));
+        assert_eq!(p.twins.len(), 4, "{:?}", p.twins);
+        assert!(p.temp(doubled).is_none(), "2 q2 is printed in the call");
+        assert!(p.temp(tripled).is_some(), "3 q2 is an output too");
+        for id in [st, ct, ss, cs] {
             assert!(!p.twins.contains_key(&id));
         }
         let (needed, vars) = p.needed(&g, &[c1]);
