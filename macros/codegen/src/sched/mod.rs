@@ -19,7 +19,10 @@
 //! get a temporary (even when used once) and the pair is recorded in
 //! [`Program::partner`]: the emitter defines the two with one call of
 //! `::pfaff::math::sin_cos`, which reduces `u` once. Pairs of plain variables (a
-//! joint angle) go two by two, in schedule order, into [`Program::twins`]: the emitter
+//! joint angle), or of sums and products of variables read by the pair alone (an
+//! absolute angle as a sum of relative ones, printed inside the call), go two by two,
+//! in schedule order and apart for arguments that read velocities, into
+//! [`Program::twins`]: the emitter
 //! defines two such pairs with one call of `::pfaff::math::sin_cos2`, which computes
 //! both in the two lanes of a register (bitwise the results of two calls).
 
@@ -29,7 +32,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;
 
 use crate::sym::transform::post_order_by;
-use crate::sym::{ExprId, Func, Graph, Node, Var};
+use crate::sym::{Deps, ExprId, Func, Graph, Node, Var};
 
 pub use runs::{Run, MIN_RUN};
 
@@ -53,8 +56,10 @@ pub struct Program {
     /// The pairs defined from the pairs of two angles they sum, by sine and by cosine.
     pub angle_sums: HashMap<ExprId, AngleSum>,
     /// For the defining member (the earlier temporary) of a [`partner`](Self::partner)
-    /// pair of a plain variable, that of the pair it shares a `sin_cos2` call with, and
-    /// the other way round: the earlier of the two defines both.
+    /// pair of a plain variable or of a sum or product of variables read by the pair
+    /// alone, that of the pair it shares a `sin_cos2` call with, and the other way
+    /// round: the earlier of the two defines both. Both arguments read velocities, or
+    /// neither does.
     pub twins: HashMap<ExprId, ExprId>,
 }
 
@@ -224,7 +229,8 @@ fn inline_arguments(
 /// [`Program::twins`]: the defining members of the sine–cosine pairs whose argument is
 /// a variable or one of the [`inline_arguments`] (read at the top of the function or
 /// computed from what is, so available wherever the earlier of two is defined), two by
-/// two in schedule order, each mapped to the other.
+/// two in schedule order among those whose argument reads no velocity and among those
+/// whose argument does, each mapped to the other.
 fn twins(
     g: &Graph,
     lets: &[ExprId],
@@ -243,9 +249,17 @@ fn twins(
         let available = matches!(g.node(u), Node::Var(_)) || inline.contains(&u);
         (first && !angle_sums.contains_key(&id) && available).then_some(id)
     });
-    let defining: Vec<ExprId> = defining.collect();
+    // Pairs of positions and pairs that read velocities apart: a function that corrects
+    // the velocities midway (`emit::corrected`) defines the first before the
+    // correction and the second after it.
+    let (moving, fixed): (Vec<ExprId>, Vec<ExprId>) = defining.partition(|&id| {
+        g.node(id)
+            .args()
+            .first()
+            .is_some_and(|&u| g.deps(u).has(Deps::QD))
+    });
     let mut twins = HashMap::new();
-    for two in defining.chunks_exact(2) {
+    for two in fixed.chunks_exact(2).chain(moving.chunks_exact(2)) {
         twins.insert(two[0], two[1]);
         twins.insert(two[1], two[0]);
     }
@@ -400,8 +414,9 @@ mod tests {
     /// The pairs of variables, and of sums and products of variables read by the pair
     /// alone (printed inline, with no temporary), go two by two into one `sin_cos2`
     /// (the earlier defines both); an odd one out stays a `sin_cos`, a pair of an
-    /// expression read elsewhere too or of a sum of angles is never a twin, and a twin
-    /// is needed with its twin.
+    /// expression read elsewhere too or of a sum of angles is never a twin, a pair of a
+    /// velocity is not a position's twin (`emit::corrected` defines them on either side
+    /// of the correction of the velocities), and a twin is needed with its twin.
     #[test]
     fn pairs_of_variables_are_twinned_in_schedule_order() {
         let mut g = Graph::new();
@@ -418,7 +433,11 @@ mod tests {
         let (st, ct) = pair(&mut g, tripled);
         let sum = g.add(vec![v[0], v[1]]);
         let (ss, cs) = pair(&mut g, sum);
-        let roots = [s0, c0, s1, c1, s2, c2, sx, cx, st, ct, tripled, ss, cs];
+        let w = g.var(Var::Qd(0));
+        let (sw, cw) = pair(&mut g, w);
+        let roots = [
+            s0, c0, s1, c1, s2, sw, cw, c2, sx, cx, st, ct, tripled, ss, cs,
+        ];
         let p = schedule(&g, &roots);
         let defining = |s: ExprId, c: ExprId| {
             if p.temp(s) < p.temp(c) {
@@ -436,8 +455,11 @@ mod tests {
         assert_eq!(p.twins.len(), 4, "{:?}", p.twins);
         assert!(p.temp(doubled).is_none(), "2 q2 is printed in the call");
         assert!(p.temp(tripled).is_some(), "3 q2 is an output too");
-        for id in [st, ct, ss, cs] {
-            assert!(!p.twins.contains_key(&id));
+        for id in [st, ct, ss, cs, sw, cw] {
+            assert!(
+                !p.twins.contains_key(&id),
+                "a velocity's pair is not a position's twin"
+            );
         }
         let (needed, vars) = p.needed(&g, &[c1]);
         assert!([s0, c0, s1, c1].iter().all(|o| needed[o.index()]));
