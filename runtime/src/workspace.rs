@@ -518,6 +518,7 @@ impl Workspace {
         t: f64,
         q: &[f64],
     ) -> Result<(), EvalError> {
+        self.check_model(mech, q, None)?;
         let info = self.info;
         let holonomic = info.nh() > 0 && info.time.holonomic;
         let nonholonomic = info.nnh() > 0 && !info.nonholonomic_homogeneous;
@@ -525,7 +526,6 @@ impl Workspace {
             // Both zero, as allocated: only this writes them.
             return Ok(());
         }
-        self.check_model(mech, q, None)?;
         if holonomic {
             mech.holonomic_rate(t, q, &mut self.ct);
             check_finite(Quantity::HolonomicRate, t, &self.ct)?;

@@ -919,7 +919,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     }
 
     /// $\ddot q$ and $\lambda$ at the current state with Baumgarte's shift of $\gamma$
-    /// (see [`accelerations`](Self::accelerations)), computed into `shift`: the terms
+    /// (see [`accelerations`](Self::accelerations)), formed in `shift` (left as it is
+    /// when the state is the one last solved at, which needs no solve): the terms
     /// with $C$ from one fused call
     /// ([`dynamics_terms_and_constraints_at`](Self::dynamics_terms_and_constraints_at)),
     /// the shift from them, the solve. The state's versions are checked once for the
