@@ -638,6 +638,20 @@ pub trait Mechanism {
         false
     }
 
+    /// The row norms $\lVert (C_q)_i\rVert_\infty$ of the holonomic Jacobian into `out`
+    /// (length `m_h`) from its pattern values `cq`; `true` when written.
+    ///
+    /// The generator emits it for every model with holonomic rows: each row's largest
+    /// magnitude over its entries in the pattern's order, a NaN entry making the norm
+    /// NaN (the runtime's walk of the pattern, whose maximum is exact, as straight-line
+    /// code). The projections' convergence tests read these norms at every iterate.
+    /// The default returns `false` and leaves `out` alone (the runtime then walks the
+    /// pattern itself). Allocates nothing.
+    fn holonomic_row_norms(&self, cq: &[f64], out: &mut [f64]) -> bool {
+        let _ = (cq, out);
+        false
+    }
+
     /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin
     /// `(x, y, z)` and then the rotation matrix to the global frame, row-major. Planar
     /// frames have `z = 0` and turn about the z axis.

@@ -791,14 +791,21 @@ impl Workspace {
     }
 
     /// $C$ of the last [`Workspace::eval_constraints`] and the row norms of the $C_q$
-    /// held in the pattern values ([`scale::pattern_row_norms`](crate::scale)): what the
-    /// projections' convergence tests read, without the dense $C_q$.
-    pub(crate) fn constraints_and_row_norms(&mut self) -> (&[f64], &[f64]) {
-        crate::scale::pattern_row_norms(
-            self.info.holonomic_pattern,
-            &self.cq_values,
-            &mut self.row_norms,
-        );
+    /// held in the pattern values, by the model's generated
+    /// [`Mechanism::holonomic_row_norms`] or else the runtime's walk of the pattern
+    /// ([`scale::pattern_row_norms`](crate::scale)): what the projections' convergence
+    /// tests read, without the dense $C_q$.
+    pub(crate) fn constraints_and_row_norms<M: Mechanism + ?Sized>(
+        &mut self,
+        mech: &M,
+    ) -> (&[f64], &[f64]) {
+        if !mech.holonomic_row_norms(&self.cq_values, &mut self.row_norms) {
+            crate::scale::pattern_row_norms(
+                self.info.holonomic_pattern,
+                &self.cq_values,
+                &mut self.row_norms,
+            );
+        }
         (&self.c, &self.row_norms)
     }
 

@@ -559,7 +559,7 @@ impl Chart {
             p.constraints(t)?;
             p.jacobian_values(t)?;
             let size = scale::coordinate_size(&p.q);
-            let (c, norms) = p.ws.constraints_and_row_norms();
+            let (c, norms) = p.ws.constraints_and_row_norms(p.mech);
             let residual = inf_norm(c);
             if scale::all_met_by_norms(c, norms, tolerance, size)
                 || (residual >= 0.5 * previous && scale::at_rounding_floor_by_norms(c, norms, size))

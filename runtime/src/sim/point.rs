@@ -1039,7 +1039,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             // The solve reads the pattern values; so do the tests (no dense C_q).
             self.constraints_with_jacobian_values(t).map_err(eval)?;
             let size = scale::coordinate_size(&self.q);
-            let (c, norms) = self.ws.constraints_and_row_norms();
+            let (c, norms) = self.ws.constraints_and_row_norms(self.mech);
             let residual = inf_norm(c);
             if scale::all_met_by_norms(c, norms, tol, size)
                 || (residual >= 0.5 * previous && scale::at_rounding_floor_by_norms(c, norms, size))

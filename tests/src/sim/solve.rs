@@ -979,6 +979,65 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
     assert!(served.len() >= 15, "models served: {served:?}");
 }
 
+/// The generated row norms of $C_q$ are the dense rows' infinity norms (the maximum is
+/// exact, so equal values; NaN where a row has a NaN entry, the other rows unchanged)
+/// for every built-in model with holonomic rows, at seeded Jacobians. The runtime's own
+/// walk of the pattern is checked against the same dense norms in `scale::tests`.
+#[test]
+fn the_generated_row_norms_are_the_dense_rows_norms() {
+    let mut served = 0;
+    for (k, entry) in pfaff_models::all().iter().enumerate() {
+        let model = (entry.make)();
+        let model = model.as_ref();
+        let info = model.info();
+        let (n, mh) = (info.nq(), info.nh());
+        if mh == 0 {
+            continue;
+        }
+        for sample in velocity_samples(model, 3, 3100 + k as u64) {
+            let VelocitySample { mut cq, g, .. } = sample;
+            for poisoned in [false, true] {
+                if poisoned {
+                    // The last entry of the first row's run.
+                    let last = info
+                        .holonomic_pattern
+                        .iter()
+                        .rposition(|&(r, _)| r == 0)
+                        .expect("row 0 has an entry");
+                    cq[last] = f64::NAN;
+                }
+                let mut dense = vec![0.0; mh * n];
+                for (i, c, v) in jacobian_entries(info, &cq, &g) {
+                    if i < mh {
+                        dense[i * n + c] = v;
+                    }
+                }
+                let mut got = vec![7.0; mh];
+                assert!(
+                    model.holonomic_row_norms(&cq, &mut got),
+                    "{}: no generated row norms",
+                    entry.name
+                );
+                for (i, &norm) in got.iter().enumerate() {
+                    let row = &dense[i * n..(i + 1) * n];
+                    let nan = row.iter().any(|v| v.is_nan());
+                    let max = row.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+                    assert!(
+                        if nan { norm.is_nan() } else { norm == max },
+                        "{} row {i}: {norm} against {max} (NaN entry: {nan})",
+                        entry.name
+                    );
+                }
+                if poisoned {
+                    assert!(got[0].is_nan(), "{}", entry.name);
+                }
+            }
+        }
+        served += 1;
+    }
+    assert!(served >= 15, "models with holonomic rows: {served}");
+}
+
 /// The generated velocity residuals (`Mechanism::velocity_residuals`) against the
 /// runtime's sums written here (each row's rate, then its entries in the pattern's
 /// order, added left to right): the same bits, on seeded states of every built-in

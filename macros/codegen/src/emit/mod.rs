@@ -492,6 +492,7 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         (d.c.len(), d.gb.len()),
         (&d.cq, &d.gm),
     ));
+    fns.extend(solve::holonomic_row_norms(d.c.len(), &d.cq));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();
         roots.extend(qd0);
