@@ -1052,7 +1052,9 @@ pub fn velocity_residuals(
 /// it NaN), straight-line code where the runtime walks the pattern entry by entry (the
 /// projections' convergence tests read the norms at every iterate).
 pub fn holonomic_row_norms(mh: usize, cq: &[Entry]) -> TokenStream {
-    if mh == 0 {
+    // Rows without entries (constraints on time alone) leave the runtime's walk, which
+    // gives them 0.
+    if mh == 0 || cq.is_empty() {
         return TokenStream::new();
     }
     let lit = Literal::usize_unsuffixed;
