@@ -1052,8 +1052,8 @@ pub fn velocity_residuals(
 /// it NaN), straight-line code where the runtime walks the pattern entry by entry (the
 /// projections' convergence tests read the norms at every iterate).
 pub fn holonomic_row_norms(mh: usize, cq: &[Entry]) -> TokenStream {
-    // Rows without entries (constraints on time alone) leave the runtime's walk, which
-    // gives them 0.
+    // A pattern without entries (every row a constraint on time alone) is left to the
+    // runtime's walk, which gives 0 (a row without entries here is written 0 too).
     if mh == 0 || cq.is_empty() {
         return TokenStream::new();
     }
