@@ -96,7 +96,9 @@ pub use pose::{isometry2_from_raw, isometry_from_raw, quaternion_from_raw, PoseE
 pub use reactions::{
     ConstraintKind, ConstraintReaction, ReactionAnalysis, ReactionHistory, Reactions,
 };
-pub use workspace::{scatter_row_major, EvalError, PatternDefect, Quantity, Workspace};
+pub use workspace::{
+    scatter_row_major, EvalError, PatternDefect, Quantity, VelocityCorrection, Workspace,
+};
 
 /// Items used by generated code. Not part of the public API.
 #[doc(hidden)]

@@ -315,6 +315,12 @@ pub fn scatter_row_major(pattern: Pattern, values: &[f64], ncols: usize, out: &m
     }
 }
 
+/// The correction of the velocities inside a fused evaluation of the dynamics terms
+/// ([`Workspace::eval_dynamics_terms_corrected`]): `correct(cq, g, ct, bias, qd)` reads
+/// the pattern values of $C_q$ and $G$ and the rates $C_t$, $g$ at the point and may
+/// change the velocities `qd` before the terms that depend on them are evaluated.
+pub type VelocityCorrection<'a> = dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]) + 'a;
+
 /// Buffers for one model, allocated once.
 #[derive(Debug, Clone)]
 pub struct Workspace {
@@ -657,8 +663,6 @@ impl Workspace {
     /// reads must have been evaluated at `(t, q)` ([`eval_rates`](Self::eval_rates)).
     /// $C$ at `(t, q)` too when `constraints`, as in
     /// [`eval_dynamics_terms_with`](Self::eval_dynamics_terms_with).
-    // A callback with the slices it reads and the velocities it corrects.
-    #[allow(clippy::type_complexity)]
     pub fn eval_dynamics_terms_corrected<M: Mechanism + ?Sized>(
         &mut self,
         mech: &M,
@@ -666,7 +670,7 @@ impl Workspace {
         q: &[f64],
         qd: &mut [f64],
         constraints: bool,
-        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+        correct: &mut VelocityCorrection<'_>,
     ) -> Result<(), EvalError> {
         self.check_model(mech, q, Some(qd))?;
         self.eval_dynamics_terms_corrected_unchecked(mech, t, q, qd, constraints, correct);
@@ -680,8 +684,6 @@ impl Workspace {
     /// on a non-finite entry; the runtime's iteration may leave non-finite velocities
     /// and report no convergence), and the caller checks the terms before anything
     /// else but the model's generated solve reads them.
-    // A callback with the slices it reads and the velocities it corrects.
-    #[allow(clippy::type_complexity)]
     #[inline]
     pub(crate) fn eval_dynamics_terms_corrected_unchecked<M: Mechanism + ?Sized>(
         &mut self,
@@ -690,7 +692,7 @@ impl Workspace {
         q: &[f64],
         qd: &mut [f64],
         constraints: bool,
-        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+        correct: &mut VelocityCorrection<'_>,
     ) {
         debug_assert!(self.check_model(mech, q, Some(qd)).is_ok());
         let (terms, (ct, bias)) = self.dynamics_outputs(constraints);

@@ -23,7 +23,7 @@ use crate::kinematics::{Kinematics, KinematicsParams};
 use crate::linalg::inf_norm;
 use crate::linalg::small::{gram_cholesky_planned, GramPlan, SmallCholesky};
 use crate::scale;
-use crate::workspace::{all_finite, EvalError, Workspace};
+use crate::workspace::{all_finite, EvalError, VelocityCorrection, Workspace};
 use crate::{Error, Info, Mechanism, NewtonParams, RANK_PIVOT};
 
 /// Pivot ratio below which a projection matrix $J J^\mathsf{T}$ counts as singular.
@@ -565,6 +565,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// [`velocity_terms`](Self::velocity_terms) at the current $(t, q)$ of version `at`.
     fn velocity_terms_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         self.jacobian_values_at(t, at)?;
+        self.rates_at(t, at)
+    }
+
+    /// The rates $C_t$, $g$ at the current $(t, q)$ of version `at`, evaluated once per
+    /// position.
+    fn rates_at(&mut self, t: f64, at: Stamp) -> Result<(), EvalError> {
         if self.rates != at {
             self.ws.eval_rates(self.mech, t, &self.q)?;
             self.rates = at;
@@ -845,18 +851,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// unchecked: a generated projection declines on a non-finite entry). Returns the
     /// versions of the corrected state, for
     /// [`accelerations_with`](Self::accelerations_with).
-    // A callback with the slices it reads and the velocities it corrects.
-    #[allow(clippy::type_complexity)]
     pub fn dynamics_terms_corrected(
         &mut self,
         t: f64,
-        correct: &mut dyn FnMut(&[f64], &[f64], &[f64], &[f64], &mut [f64]),
+        correct: &mut VelocityCorrection<'_>,
     ) -> Result<(Stamp, Stamp), EvalError> {
         let at = self.position(t);
-        if self.rates != at {
-            self.ws.eval_rates(self.mech, t, &self.q)?;
-            self.rates = at;
-        }
+        self.rates_at(t, at)?;
         let with_c = self.constraints_asked() && self.constraints != at;
         self.jacobian = 0;
         self.terms = 0;
