@@ -281,6 +281,12 @@ fn check(input: &TokenStream) -> Result<bool, String> {
     }
     let file = syn::parse2::<syn::File>(out.clone())
         .map_err(|e| format!("the expansion does not parse ({e}): {out}"))?;
+    if out.to_string().contains("recorded no cause") {
+        return Err(format!(
+            "the generator stopped without a diagnostic: {}",
+            pfaff_codegen::UNEXPLAINED
+        ));
+    }
     let error = file.items.iter().any(|item| {
         matches!(item, syn::Item::Macro(m) if m.mac.path.segments.last().is_some_and(|s| s.ident == "compile_error"))
     });

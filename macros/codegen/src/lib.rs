@@ -34,6 +34,11 @@ pub mod sym;
 
 use proc_macro2::TokenStream;
 
+/// The error reported when the derivation stops without recording why: a defect of
+/// the generator, never of the model.
+pub const UNEXPLAINED: &str = "pfaff could not derive this model and recorded no cause; \
+this is a defect of pfaff's generator, please report it with the model";
+
 /// The results of the front and middle stages for one model.
 #[derive(Debug)]
 pub struct Analysis {
@@ -57,8 +62,16 @@ pub fn analyze(args: TokenStream, input: TokenStream) -> syn::Result<Analysis> {
     } else {
         derive::derive(&cx, &model, &mut graph)
     };
+    let Some(derived) = derived else {
+        // Every stage records why it stops; a stop without a diagnostic is a defect of
+        // the generator, reported as one (the fuzz campaign looks for this message).
+        if !cx.has_errors() {
+            cx.error_at(proc_macro2::Span::call_site(), UNEXPLAINED);
+        }
+        cx.check()?;
+        unreachable!("the context holds an error");
+    };
     cx.check()?;
-    let derived = derived.expect("derivation succeeds when no error was recorded");
     Ok(Analysis {
         model,
         graph,

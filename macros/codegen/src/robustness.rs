@@ -232,3 +232,31 @@ fn user_errors_are_diagnostics() {
         );
     }
 }
+
+/// A spatial revolute joint without `axis_a` (optional only for a planar one) is a
+/// compile error, not a panic (found by the fuzz campaign, seed 1795831916, case 20483).
+#[test]
+fn a_spatial_revolute_joint_without_its_axis_is_an_error() {
+    let out = expand(quote!(
+        mod hinge {
+            static x: Coordinate = Coordinate {};
+            static y: Coordinate = Coordinate {};
+            static z: Coordinate = Coordinate {};
+            static psi: Coordinate = Coordinate {};
+            static door: Body = Body {
+                origin: [x, y, z],
+                rotation: rot_z(psi),
+                mass: 1.0,
+                inertia: diag(1.0, 1.0, 1.0),
+            };
+            static pivot: Joint = Revolute {
+                a: door,
+                at_b: [0.0, 0.0, 0.0],
+                axis_b: [0.0, 0.0, 1.0],
+            };
+        }
+    ))
+    .expect("expansion does not panic");
+    assert!(out.contains("compile_error"), "{out}");
+    assert!(out.contains("needs `axis_a`"), "{out}");
+}

@@ -1363,6 +1363,16 @@ impl<'a> Builder<'_, 'a> {
             | ("Universal", false)
             | ("Cylindrical", false)
             | ("Prismatic", false) => {
+                // Only the revolute joint leaves `axis_a` optional (a planar one takes none).
+                if fl.get("axis_a").is_none() {
+                    self.cx.error_spanned_by(
+                        &d.expr,
+                        format!(
+                            "a spatial `{kind}` joint needs `axis_a`, the axis it turns about in `a`'s frame"
+                        ),
+                    );
+                    return None;
+                }
                 let (ua, p1a, p2a) = axis(self, "axis_a")?;
                 let (ub, p1b, p2b) = match fl.get("axis_b") {
                     Some(_) => axis(self, "axis_b")?,
