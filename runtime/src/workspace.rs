@@ -191,14 +191,20 @@ pub(crate) fn all_finite(x: &[f64]) -> bool {
 
 /// Checks that every entry of `x` is finite.
 pub(crate) fn check_finite(quantity: Quantity, t: f64, x: &[f64]) -> Result<(), EvalError> {
+    check_finite_from(quantity, t, x, 0)
+}
+
+/// [`check_finite`] for the rows `first..` of a vector (the non-holonomic rows of
+/// $\gamma$ after its `first` holonomic ones): an error names the row in the whole.
+fn check_finite_from(quantity: Quantity, t: f64, x: &[f64], first: usize) -> Result<(), EvalError> {
     match x.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
-        Some(row) => Err(EvalError::NonFinite {
+        Some(k) => Err(EvalError::NonFinite {
             quantity,
             t,
-            row,
+            row: first + k,
             col: None,
-            value: x[row],
+            value: x[k],
         }),
     }
 }
@@ -564,22 +570,7 @@ impl Workspace {
         }
         if !nh.is_empty() {
             mech.nonholonomic_gamma(t, q, qd, nh);
-            check_finite(Quantity::NonholonomicGamma, t, nh).map_err(|e| match e {
-                EvalError::NonFinite {
-                    quantity,
-                    t,
-                    row,
-                    col,
-                    value,
-                } => EvalError::NonFinite {
-                    quantity,
-                    t,
-                    row: row + mh,
-                    col,
-                    value,
-                },
-                other => other,
-            })?;
+            check_finite_from(Quantity::NonholonomicGamma, t, nh, mh)?;
         }
         Ok(())
     }
@@ -752,22 +743,7 @@ impl Workspace {
             &self.g_values,
         )?;
         check_finite(Quantity::HolonomicGamma, t, &self.gamma[..mh])?;
-        check_finite(Quantity::NonholonomicGamma, t, &self.gamma[mh..]).map_err(|e| match e {
-            EvalError::NonFinite {
-                quantity,
-                t,
-                row,
-                col,
-                value,
-            } => EvalError::NonFinite {
-                quantity,
-                t,
-                row: row + mh,
-                col,
-                value,
-            },
-            other => other,
-        })
+        check_finite_from(Quantity::NonholonomicGamma, t, &self.gamma[mh..], mh)
     }
 
     /// Scatters the pattern values of $C_q$ and $G$ into the dense $J$: only the

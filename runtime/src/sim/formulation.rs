@@ -48,20 +48,27 @@ pub(crate) trait Form {
     const CORRECTION: Correction;
 
     /// Takes the current full state of `p` (consistent, at `t`) as the last accepted
-    /// one.
+    /// one. By default there is nothing to take: the formulation keeps no state of
+    /// its own.
     fn accept<M: Mechanism + ?Sized>(
         &mut self,
-        p: &mut Point<'_, M>,
-        t: f64,
-    ) -> Result<(), SimErrorKind>;
+        _p: &mut Point<'_, M>,
+        _t: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
 
-    /// Fills `p.q`, `p.qd` from the state `y` at `t`.
+    /// Fills `p.q`, `p.qd` from the state `y` at `t`. By default `y` is $[q; \dot q]$
+    /// itself.
     fn reconstruct<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
-        t: f64,
+        _t: f64,
         y: &[f64],
-    ) -> Result<(), SimErrorKind>;
+    ) -> Result<(), SimErrorKind> {
+        copy_state(p, y);
+        Ok(())
+    }
 
     /// $\ddot q$ and $\lambda$ at the full state of `p`.
     fn accelerations<M: Mechanism + ?Sized>(
@@ -82,14 +89,20 @@ pub(crate) trait Form {
     }
 
     /// Corrects a state the driver keeps (accepted or output), already reconstructed.
+    /// By default it is kept as integrated ([`Correction::None`]).
     fn keep<M: Mechanism + ?Sized>(
         &mut self,
-        p: &mut Point<'_, M>,
-        t: f64,
-    ) -> Result<(), SimErrorKind>;
+        _p: &mut Point<'_, M>,
+        _t: f64,
+    ) -> Result<(), SimErrorKind> {
+        Ok(())
+    }
 
-    /// Whether a failure of the right-hand side only rejects the step attempt.
-    fn recoverable(&self, e: &SimErrorKind) -> bool;
+    /// Whether a failure of the right-hand side only rejects the step attempt. By
+    /// default none does: every failure ends the run with its typed error.
+    fn recoverable(&self, _e: &SimErrorKind) -> bool {
+        false
+    }
 }
 
 /// Whether `e` is the augmented solve's inconsistency of redundant rows: a failure of a
@@ -398,24 +411,6 @@ pub(crate) struct Projected;
 impl Form for Projected {
     const CORRECTION: Correction = Correction::Changed;
 
-    fn accept<M: Mechanism + ?Sized>(
-        &mut self,
-        _: &mut Point<'_, M>,
-        _: f64,
-    ) -> Result<(), SimErrorKind> {
-        Ok(())
-    }
-
-    fn reconstruct<M: Mechanism + ?Sized>(
-        &mut self,
-        p: &mut Point<'_, M>,
-        _: f64,
-        y: &[f64],
-    ) -> Result<(), SimErrorKind> {
-        copy_state(p, y);
-        Ok(())
-    }
-
     fn accelerations<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
@@ -458,24 +453,6 @@ impl Stabilized {
 impl Form for Stabilized {
     const CORRECTION: Correction = Correction::None;
 
-    fn accept<M: Mechanism + ?Sized>(
-        &mut self,
-        _: &mut Point<'_, M>,
-        _: f64,
-    ) -> Result<(), SimErrorKind> {
-        Ok(())
-    }
-
-    fn reconstruct<M: Mechanism + ?Sized>(
-        &mut self,
-        p: &mut Point<'_, M>,
-        _: f64,
-        y: &[f64],
-    ) -> Result<(), SimErrorKind> {
-        copy_state(p, y);
-        Ok(())
-    }
-
     /// With $\gamma$ shifted by $-2\alpha[C_q\dot q + C_t; G\dot q + g] - \beta^2[C; 0]$.
     fn accelerations<M: Mechanism + ?Sized>(
         &mut self,
@@ -483,18 +460,6 @@ impl Form for Stabilized {
         t: f64,
     ) -> Result<(), SimErrorKind> {
         p.stabilized_accelerations(t, self.alpha, self.beta, &mut self.shift)
-    }
-
-    fn keep<M: Mechanism + ?Sized>(
-        &mut self,
-        _: &mut Point<'_, M>,
-        _: f64,
-    ) -> Result<(), SimErrorKind> {
-        Ok(())
-    }
-
-    fn recoverable(&self, _: &SimErrorKind) -> bool {
-        false
     }
 }
 
@@ -505,42 +470,12 @@ pub(crate) struct Free;
 impl Form for Free {
     const CORRECTION: Correction = Correction::None;
 
-    fn accept<M: Mechanism + ?Sized>(
-        &mut self,
-        _: &mut Point<'_, M>,
-        _: f64,
-    ) -> Result<(), SimErrorKind> {
-        Ok(())
-    }
-
-    fn reconstruct<M: Mechanism + ?Sized>(
-        &mut self,
-        p: &mut Point<'_, M>,
-        _: f64,
-        y: &[f64],
-    ) -> Result<(), SimErrorKind> {
-        copy_state(p, y);
-        Ok(())
-    }
-
     fn accelerations<M: Mechanism + ?Sized>(
         &mut self,
         p: &mut Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
         p.free_accelerations(t)
-    }
-
-    fn keep<M: Mechanism + ?Sized>(
-        &mut self,
-        _: &mut Point<'_, M>,
-        _: f64,
-    ) -> Result<(), SimErrorKind> {
-        Ok(())
-    }
-
-    fn recoverable(&self, _: &SimErrorKind) -> bool {
-        false
     }
 }
 
