@@ -93,6 +93,11 @@ fn end_time_before_the_start() {
     );
     // `--t-end 0` is valid: it analyses the initial state (tests/cli_outputs.rs).
     bad(&["work-precision", "pendulum", "--t-end", "-2"]);
+    // Not a number is not a time, rather than a time before the start.
+    for command in ["simulate", "work-precision"] {
+        let err = bad(&[command, "pendulum", "--t-end", "NaN"]);
+        assert!(err.contains("--t-end NaN is not a finite time"), "{err}");
+    }
 }
 
 #[test]

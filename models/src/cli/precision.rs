@@ -19,8 +19,13 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let scene = Scene::of(entry.name);
     let t_end = args.t_end.unwrap_or(scene.t_end);
     if !t_end.is_finite() || t_end <= 0.0 {
+        let what = if t_end <= 0.0 {
+            "is not after the start time 0"
+        } else {
+            "is not a finite time"
+        };
         return Err(usage(format!(
-            "--t-end {t_end} is not after the start time 0: expected a positive finite end time"
+            "--t-end {t_end} {what}: expected a positive finite end time"
         )));
     }
     let (reference, source) = match scene.closed_form {

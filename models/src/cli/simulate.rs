@@ -67,8 +67,13 @@ pub fn request<'a>(
     positive("--atol", args.atol, true)?;
     let t_end = args.t_end.unwrap_or(scene.t_end);
     if !t_end.is_finite() || t_end < 0.0 {
+        let what = if t_end < 0.0 {
+            "is before the start time 0"
+        } else {
+            "is not a finite time"
+        };
         return Err(usage(format!(
-            "--t-end {t_end} is before the start time 0: expected a finite end time, at least 0 (0 analyses the initial state)"
+            "--t-end {t_end} {what}: expected a finite end time, at least 0 (0 analyses the initial state)"
         )));
     }
     let mut notes = Vec::new();
