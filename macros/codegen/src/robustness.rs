@@ -260,3 +260,68 @@ fn a_spatial_revolute_joint_without_its_axis_is_an_error() {
     assert!(out.contains("compile_error"), "{out}");
     assert!(out.contains("needs `axis_a`"), "{out}");
 }
+
+/// A deformable body whose material closure reads its own `material(..)` is a compile
+/// error at the call (it recursed until the stack overflowed, which no `catch_unwind`
+/// catches), in the position closure and in the displacement closure alike.
+#[test]
+fn a_material_closure_that_reads_its_own_material_is_an_error() {
+    let position = expand(quote!(
+        mod m {
+            static x: Coordinate = Coordinate {};
+            static y: Coordinate = Coordinate {};
+            static rod: Body = Deformable {
+                origin: [x, 0.0],
+                angle: 0.0,
+                elastic: [y],
+                position: |xi| rod.material(xi),
+                displacement: |xi| [0.0, xi * y],
+                density: 1.0,
+                span: 0.0..1.0,
+            };
+        }
+    ))
+    .expect("expansion does not panic");
+    let displacement = expand(quote!(
+        mod m {
+            static x: Coordinate = Coordinate {};
+            static y: Coordinate = Coordinate {};
+            static rod: Body = Deformable {
+                origin: [x, 0.0],
+                angle: 0.0,
+                elastic: [y],
+                position: |xi| [xi, 0.0],
+                displacement: |xi| rod.material(xi),
+                density: 1.0,
+                span: 0.0..1.0,
+            };
+        }
+    ))
+    .expect("expansion does not panic");
+    for out in [position, displacement] {
+        assert!(out.contains("cannot use its own `material(..)`"), "{out}");
+        assert_eq!(out.matches("compile_error").count(), 1, "one error: {out}");
+    }
+}
+
+/// A mass matrix written by the user in a model with frames but no body is the
+/// model's mass matrix (it was dropped for the bodies' kinetic energy, zero).
+#[test]
+fn a_mass_matrix_beside_frames_without_bodies_is_kept() {
+    let out = expand(quote!(
+        mod m {
+            static x: Coordinate = Coordinate {};
+            static f: Frame = Frame {
+                origin: [x, 0.0],
+                angle: 0.0,
+            };
+            fn mass_matrix() -> [[f64; 1]; 1] {
+                [[7.0]]
+            }
+        }
+    ))
+    .expect("expansion does not panic");
+    assert!(!out.contains("compile_error"), "{out}");
+    let mass = function(&out, "mass_matrix");
+    assert!(mass.contains("7f64") || mass.contains("7.0"), "{mass}");
+}

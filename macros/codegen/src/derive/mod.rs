@@ -169,12 +169,15 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
             )
         })
         .collect();
+    // A mass matrix the user wrote comes before the bodies' kinetic energy: lowering
+    // refuses both together, but a model with frames and no body has a body level
+    // whose kinetic energy is zero.
     let kinetic = if let Some(k) = &model.kinetic {
         tr.block(&k.block, Context::Kinetic)
-    } else if body_level.is_some() {
-        Some(tr.g.constant(0.0))
     } else if let Some(m) = &model.mass_matrix {
         checks::kinetic_from_mass_matrix(cx, model, m, &mut tr, checking, &param_defaults)
+    } else if body_level.is_some() {
+        Some(tr.g.constant(0.0))
     } else {
         None
     };

@@ -95,6 +95,9 @@ pub struct Translator<'a> {
     /// The material description of deformable bodies, by frame index (for
     /// `body.material(ξ)`).
     pub materials: Vec<(usize, super::value::Material)>,
+    /// The frames whose material description is being expanded (a description that
+    /// reads its own body's `material` would never end).
+    pub expanding_materials: Vec<usize>,
 }
 
 const METHODS: &[&str] = &[
@@ -119,6 +122,7 @@ impl<'a> Translator<'a> {
             point_names: model.point_names(),
             points: Vec::new(),
             materials: Vec::new(),
+            expanding_materials: Vec::new(),
         }
     }
 

@@ -1016,17 +1016,27 @@ impl Translator<'_> {
                     self.materials
                         .iter()
                         .find(|(i, _)| *i == k)
-                        .map(|(_, m)| m.clone())
+                        .map(|(_, m)| (k, m.clone()))
                 });
-                let Some(material) = material else {
+                let Some((k, material)) = material else {
                     self.cx.error_spanned_by(
                         &m.method,
                         "`material` applies to deformable bodies (`Deformable { .. }`)",
                     );
                     return None;
                 };
+                if self.expanding_materials.contains(&k) {
+                    self.cx.error_spanned_by(
+                        &m.method,
+                        "a deformable body's `position` and `displacement` cannot use its own `material(..)`, which they define",
+                    );
+                    return None;
+                }
                 let xi = self.expr(&m.args[0])?;
-                Value::Vector(material.at(self, &m.args[0], xi)?)
+                self.expanding_materials.push(k);
+                let at = material.at(self, &m.args[0], xi);
+                self.expanding_materials.pop();
+                Value::Vector(at?)
             }
             "node" => {
                 let nodes = f.and_then(|k| {
