@@ -77,6 +77,17 @@ fn negative_or_invalid_numbers() {
         "--step",
         "-0.1",
     ]);
+    let err = bad(&[
+        "simulate",
+        "pendulum",
+        "--samples",
+        "100000000",
+        "--csv",
+        "x.csv",
+    ]);
+    assert!(err.contains("--samples 100000000"), "{err}");
+    let err = bad(&["simulate", "pendulum", "--atol", "0"]);
+    assert!(err.contains("--atol 0: expected a positive"), "{err}");
     let err = bad(&["simulate", "pendulum", "--repeat", "0"]);
     assert!(err.contains("--repeat 0"), "{err}");
     let err = bad(&["rhs-time", "pendulum", "--calls", "0"]);

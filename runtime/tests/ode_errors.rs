@@ -207,6 +207,14 @@ fn bad_arguments_are_errors() {
         Dopri5::new(1, OdeOptions::with_tol(-1.0)),
         Err(OdeError::InvalidTolerance { .. })
     ));
+    // A zero atol leaves a component through zero a weight of zero (it failed later,
+    // as a non-finite value at t = inf).
+    let mut relative = OdeOptions::with_tol(1e-6);
+    relative.tol.atol = 0.0;
+    assert!(matches!(
+        Dop853::new(1, relative),
+        Err(OdeError::InvalidTolerance { .. })
+    ));
     let mut ode = Dop853::new(1, OdeOptions::default()).unwrap();
     assert!(matches!(
         ode.step(&mut sys, None),

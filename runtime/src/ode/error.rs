@@ -71,9 +71,9 @@ pub enum OdeError {
         /// The length that was given.
         found: usize,
     },
-    /// Tolerances must be finite, non-negative and not both zero for a component, and
-    /// `rtol` at most 1.
-    #[error("invalid tolerances rtol = {rtol:e}, atol = {atol:e}, expected finite non-negative values, not both zero, rtol at most 1")]
+    /// `rtol` must be finite, non-negative and at most 1, `atol` finite and positive
+    /// (for every component).
+    #[error("invalid tolerances rtol = {rtol:e}, atol = {atol:e}: expected 0 <= rtol <= 1 and a finite atol > 0")]
     InvalidTolerance {
         /// The relative tolerance.
         rtol: f64,

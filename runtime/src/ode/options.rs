@@ -1,8 +1,8 @@
 //! Tolerances, options and work statistics shared by the integrators.
 //!
 //! Input: user settings. Output: validated settings (`validate`) and counters.
-//! Invariants: a validated [`Tolerances`] has finite, non-negative `rtol` (at most 1) and `atol`
-//! with $\text{atol}_i + \text{rtol} > 0$ for every component.
+//! Invariants: a validated [`Tolerances`] has a finite, non-negative `rtol` (at most 1) and
+//! a finite, positive `atol` for every component.
 
 use super::error::OdeError;
 
@@ -62,19 +62,21 @@ impl Tolerances {
     ///
     /// # Errors
     /// [`OdeError::DimensionMismatch`] for a per-component vector of the wrong length,
-    /// [`OdeError::InvalidTolerance`] for negative or non-finite values, an `rtol` above
-    /// 1, or a component with both tolerances zero.
+    /// [`OdeError::InvalidTolerance`] for an `rtol` that is negative, not finite or above
+    /// 1, or an `atol` that is not positive and finite.
     pub fn validate(&self, dim: usize) -> Result<(), OdeError> {
         let bad = |atol: f64| OdeError::InvalidTolerance {
             rtol: self.rtol,
             atol,
         };
-        let ok = |x: f64| x.is_finite() && x >= 0.0;
         // A relative tolerance above 1 asks for no correct digit: the error estimate
         // could never be compared with the solution meaningfully.
-        if !ok(self.rtol) || self.rtol > 1.0 {
+        if !(self.rtol.is_finite() && self.rtol >= 0.0) || self.rtol > 1.0 {
             return Err(bad(self.atol));
         }
+        // A zero absolute tolerance leaves a component that passes through zero a
+        // weight of zero (a pure relative test there divides by it).
+        let ok = |x: f64| x.is_finite() && x > 0.0;
         if let Some(a) = &self.atol_components {
             if a.len() != dim {
                 return Err(OdeError::DimensionMismatch {
@@ -82,10 +84,10 @@ impl Tolerances {
                     found: a.len(),
                 });
             }
-            if let Some(&x) = a.iter().find(|&&x| !ok(x) || x + self.rtol == 0.0) {
+            if let Some(&x) = a.iter().find(|&&x| !ok(x)) {
                 return Err(bad(x));
             }
-        } else if !ok(self.atol) || self.atol + self.rtol == 0.0 {
+        } else if !ok(self.atol) {
             return Err(bad(self.atol));
         }
         Ok(())
