@@ -181,7 +181,7 @@ fn rtol_above_one_is_refused() {
 /// assembly, a failed run and a write error, each with an `error` entry.
 #[test]
 fn json_is_one_object_for_every_exit_code() {
-    let cases: [(&[&str], i32, &str); 6] = [
+    let cases: [(&[&str], i32, &str); 8] = [
         (&["simulate", "pendulum", "--set", "zz=1"], 2, "usage"),
         (&["simulate", "pendulum", "--bogus"], 2, "usage"),
         (&["linearize", "pendulum", "--set", "zz=1"], 2, "usage"),
@@ -199,6 +199,19 @@ fn json_is_one_object_for_every_exit_code() {
             &["simulate", "pendulum", "--csv", "/nonexistent/dir/a.csv"],
             1,
             "io",
+        ),
+        // A ball started half a metre into its floor, and a floor raised into the
+        // double pendulum's tip (it was impacts, a resting contact and a Newton
+        // failure that said every residual was within the tolerance).
+        (
+            &["simulate", "bouncing_ball", "--q0", "y=-0.5"],
+            1,
+            "initial_penetration",
+        ),
+        (
+            &["simulate", "pendulum_floor", "--set", "depth=1.6"],
+            1,
+            "initial_penetration",
         ),
     ];
     for (args, code, kind) in cases {

@@ -225,6 +225,7 @@ fn kind_name(kind: &SimErrorKind) -> &'static str {
         SimErrorKind::InvalidTimes { .. } => "invalid_times",
         SimErrorKind::InitialLength { .. } => "initial_length",
         SimErrorKind::Assembly(_) => "assembly",
+        SimErrorKind::InitialPenetration { .. } => "initial_penetration",
         SimErrorKind::NewtonFailed { .. } => "newton_failed",
         SimErrorKind::Singular { .. } => "singular",
         SimErrorKind::SingularMass { .. } => "singular_mass",

@@ -188,6 +188,32 @@ impl Contacts {
         Ok(())
     }
 
+    /// Checks that no contact starts penetrated: every gap at the initial positions of
+    /// `p` is at least $-\varepsilon(1 + \lVert q\rVert_\infty)$ with the consistency
+    /// tolerance of a prescribed state ([`crate::assembly::CONSISTENCY_TOLERANCE`]).
+    /// A deeper one is an error naming the deepest contact; the resting-contact
+    /// projection could not move the state out of it.
+    pub fn check_initial<M: Mechanism + ?Sized>(
+        &mut self,
+        p: &super::point::Point<'_, M>,
+        t: f64,
+    ) -> Result<(), SimErrorKind> {
+        self.gaps_at(p.mech, t, &p.q)?;
+        let tolerance = crate::assembly::CONSISTENCY_TOLERANCE * (1.0 + inf_norm(&p.q));
+        let deepest = (0..self.g.len())
+            .filter(|&k| self.g[k] < -tolerance)
+            .min_by(|&a, &b| self.g[a].total_cmp(&self.g[b]));
+        match deepest {
+            None => Ok(()),
+            Some(k) => Err(SimErrorKind::InitialPenetration {
+                t,
+                contact: self.info.contacts[k].name,
+                gap: self.g[k],
+                tolerance,
+            }),
+        }
+    }
+
     /// Records the state at the left end of the next step (after an accepted step or
     /// an event); the point holds the kept state at `t`.
     pub fn anchor<M: Mechanism + ?Sized>(

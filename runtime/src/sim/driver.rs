@@ -329,9 +329,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     if let Err(e) = sys.accept(t0) {
         return Err(empty(e));
     }
-    // Contacts closed at the start: impacts, then rest.
+    // Contacts closed at the start: impacts, then rest (none may start penetrated).
     let mut h_first = None;
-    if sys.contacts.is_some() {
+    if let Some(c) = sys.contacts.as_mut() {
+        if let Err(e) = c.check_initial(&sys.point, t0) {
+            return Err(empty(e));
+        }
         let r = super::contacts::handle(&mut sys, None, t0).and_then(|h| {
             sys.accept(t0)?;
             if let Some(c) = sys.contacts.as_mut() {

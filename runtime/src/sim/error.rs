@@ -112,6 +112,19 @@ pub enum SimErrorKind {
     /// Consistent initial conditions could not be assembled.
     #[error("cannot assemble the initial conditions: {0}")]
     Assembly(#[from] AssemblyError),
+    /// The initial positions put a contact's gap below zero by more than the
+    /// consistency tolerance: the bodies start inside each other.
+    #[error("the initial state penetrates contact `{contact}` at t = {t}: its gap is {gap:e} (below -{tolerance:.1e}); start the contact touching (gap 0) or open")]
+    InitialPenetration {
+        /// Time.
+        t: f64,
+        /// The deepest penetrating contact.
+        contact: &'static str,
+        /// Its gap, negative.
+        gap: f64,
+        /// The largest penetration accepted as touching.
+        tolerance: f64,
+    },
     /// A Newton iteration (K1 or the position projection) did not converge.
     #[error("Newton iteration failed at t = {t} after {iterations} iterations: residual {residual:e}, {}", involved("constraints", constraints, "every residual is within the tolerance, the iteration stalled or kept landing on another solution branch"))]
     NewtonFailed {
