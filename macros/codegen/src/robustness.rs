@@ -266,39 +266,29 @@ fn a_spatial_revolute_joint_without_its_axis_is_an_error() {
 /// catches), in the position closure and in the displacement closure alike.
 #[test]
 fn a_material_closure_that_reads_its_own_material_is_an_error() {
-    let position = expand(quote!(
-        mod m {
-            static x: Coordinate = Coordinate {};
-            static y: Coordinate = Coordinate {};
-            static rod: Body = Deformable {
-                origin: [x, 0.0],
-                angle: 0.0,
-                elastic: [y],
-                position: |xi| rod.material(xi),
-                displacement: |xi| [0.0, xi * y],
-                density: 1.0,
-                span: 0.0..1.0,
-            };
-        }
-    ))
-    .expect("expansion does not panic");
-    let displacement = expand(quote!(
-        mod m {
-            static x: Coordinate = Coordinate {};
-            static y: Coordinate = Coordinate {};
-            static rod: Body = Deformable {
-                origin: [x, 0.0],
-                angle: 0.0,
-                elastic: [y],
-                position: |xi| [xi, 0.0],
-                displacement: |xi| rod.material(xi),
-                density: 1.0,
-                span: 0.0..1.0,
-            };
-        }
-    ))
-    .expect("expansion does not panic");
-    for out in [position, displacement] {
+    let rod = |position: TokenStream, displacement: TokenStream| {
+        quote!(
+            mod m {
+                static x: Coordinate = Coordinate {};
+                static y: Coordinate = Coordinate {};
+                static rod: Body = Deformable {
+                    origin: [x, 0.0],
+                    angle: 0.0,
+                    elastic: [y],
+                    position: #position,
+                    displacement: #displacement,
+                    density: 1.0,
+                    span: 0.0..1.0,
+                };
+            }
+        )
+    };
+    let own = quote!(|xi| rod.material(xi));
+    for src in [
+        rod(own.clone(), quote!(|xi| [0.0, xi * y])),
+        rod(quote!(|xi| [xi, 0.0]), own),
+    ] {
+        let out = expand(src).expect("expansion does not panic");
         assert!(out.contains("cannot use its own `material(..)`"), "{out}");
         assert_eq!(out.matches("compile_error").count(), 1, "one error: {out}");
     }
