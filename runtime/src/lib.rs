@@ -109,6 +109,7 @@ pub mod __private {
         AugmentedSolve, Body, Contact, DataError, DataSlot, DynamicsTerms, Frame, Info, Joint,
         JointKind, Mechanism, Parameter, Point, Symbol, TimeDependence,
     };
+    pub use crate::scale::norm_step;
 
     /// `Σ_k a[k·stride] x[k]`: a contraction of a run-time data slot with consecutive
     /// coordinates or velocities, which generated code calls instead of unrolling the

@@ -52,14 +52,26 @@ pub(crate) fn all_met(c: &[f64], jacobian: &[f64], n: usize, tolerance: f64, siz
     unmet(c, jacobian, n, tolerance, size).next().is_none()
 }
 
+/// One step of a row norm's maximum: `a` when it is larger than the norm `m` so far or
+/// NaN, `m` otherwise. Once NaN, a norm stays NaN (`a > NaN` is false, and a NaN `a`
+/// replaces it). The rule of the runtime's walk of a pattern and of the generated
+/// [`Mechanism::holonomic_row_norms`](crate::Mechanism::holonomic_row_norms), which
+/// calls it, so that the two give the same norms.
+#[inline(always)]
+pub fn norm_step(m: f64, a: f64) -> f64 {
+    if a > m || a.is_nan() {
+        a
+    } else {
+        m
+    }
+}
+
 /// The row norms $\lVert (C_q)_i\rVert_\infty$ of a Jacobian given by its `pattern`
 /// (entries in any order) and `values`, into `norms` (one per row): the numbers
 /// [`inf_norm`] gives on the dense rows, whose other entries are zeros (the maximum is
 /// exact; a NaN entry makes its row's norm NaN). What the projections' convergence
 /// tests read, without scattering the dense $C_q$.
 pub(crate) fn pattern_row_norms(pattern: &[(u32, u32)], values: &[f64], norms: &mut [f64]) {
-    // Once NaN, a norm stays NaN: `a > NaN` is false.
-    let larger = |m: f64, a: f64| if a > m || a.is_nan() { a } else { m };
     norms.fill(0.0);
     // The maximum of a run of entries of one row in a register, stored when the row
     // changes (not stored and reloaded entry by entry, each waiting for the last).
@@ -71,12 +83,12 @@ pub(crate) fn pattern_row_norms(pattern: &[(u32, u32)], values: &[f64], norms: &
     for (&(r, _), v) in entries {
         let r = r as usize;
         if r != row {
-            norms[row] = larger(norms[row], norm);
+            norms[row] = norm_step(norms[row], norm);
             (row, norm) = (r, 0.0);
         }
-        norm = larger(norm, v.abs());
+        norm = norm_step(norm, v.abs());
     }
-    norms[row] = larger(norms[row], norm);
+    norms[row] = norm_step(norms[row], norm);
 }
 
 /// [`all_met`] with the row norms of $C_q$ given (see [`pattern_row_norms`]): the

@@ -1048,9 +1048,9 @@ pub fn velocity_residuals(
 
 /// The trait method `holonomic_row_norms`, for every model with holonomic rows: each
 /// row's largest magnitude, from `0.0` over its entries in the pattern's order with the
-/// runtime's rule (a larger magnitude or a NaN replaces the norm, so a NaN entry leaves
-/// it NaN), straight-line code where the runtime walks the pattern entry by entry (the
-/// projections' convergence tests read the norms at every iterate).
+/// runtime's rule (`norm_step`: a larger magnitude or a NaN replaces the norm, so a NaN
+/// entry leaves it NaN), straight-line code where the runtime walks the pattern entry by
+/// entry (the projections' convergence tests read the norms at every iterate).
 pub fn holonomic_row_norms(mh: usize, cq: &[Entry]) -> TokenStream {
     // A pattern without entries (every row a constraint on time alone) is left to the
     // runtime's walk, which gives 0 (a row without entries here is written 0 too).
@@ -1063,7 +1063,7 @@ pub fn holonomic_row_norms(mh: usize, cq: &[Entry]) -> TokenStream {
         let mut norm = quote!(0.0);
         for (k, _) in cq.iter().enumerate().filter(|(_, e)| e.row as usize == i) {
             let k = lit(k);
-            norm = quote!(larger(#norm, cq[#k].abs()));
+            norm = quote!(step(#norm, cq[#k].abs()));
         }
         let i = lit(i);
         rows.extend(quote!(out[#i] = #norm;));
@@ -1071,7 +1071,7 @@ pub fn holonomic_row_norms(mh: usize, cq: &[Entry]) -> TokenStream {
     let (cq_len, mh_lit) = (lit(cq.len()), lit(mh));
     quote! {
         fn holonomic_row_norms(&self, cq: &[f64], out: &mut [f64]) -> bool {
-            let larger = |m: f64, a: f64| if a > m || a.is_nan() { a } else { m };
+            let step = ::pfaff::__private::norm_step;
             let cq = &cq[..#cq_len];
             let out = &mut out[..#mh_lit];
             #rows
