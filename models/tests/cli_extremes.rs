@@ -253,3 +253,29 @@ fn linearize_label_names_the_given_state() {
     assert_eq!(v["operating_point"]["about"], "hanging at rest", "{v}");
     assert_eq!(v["operating_point"]["q"]["y"], -1.0, "{v}");
 }
+
+/// Times far below a second or far above are written in exponent form in the summary
+/// and in the errors: `--t-end 1e-300` printed 300 zeros twice, and an error at
+/// 7.6e-12 s read `t = 0.000000000007612119398285161`.
+#[test]
+fn tiny_and_huge_times_are_written_with_an_exponent() {
+    let out = pfaff(&["simulate", "pendulum", "--t-end", "1e-300"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("span         0 to 1e-300 s"), "{text}");
+    assert!(text.contains("final        t = 1e-300:"), "{text}");
+    assert!(!text.contains(&"0".repeat(20)), "{text}");
+    // An ordinary span stays as written.
+    let out = pfaff(&["simulate", "pendulum", "--t-end", "3"]);
+    assert!(
+        stdout(&out).contains("span         0 to 3 s"),
+        "{}",
+        stdout(&out)
+    );
+    // The zero-length pendulum fails within the first microsecond: its error's time.
+    let out = pfaff(&["simulate", "pendulum", "--set", "l=0"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("e-"), "{err}");
+    assert!(!err.contains("t = 0.0000"), "{err}");
+}

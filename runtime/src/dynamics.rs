@@ -154,7 +154,7 @@ pub struct AccelerationStats {
 pub enum DynamicsError {
     /// The augmented matrix is singular although $J$ has full rank (or the reduced one
     /// is singular): $M$ is not positive definite on $\ker J$.
-    #[error("augmented system singular at t = {t} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", free_list(coordinates))]
+    #[error("augmented system singular at t = {t:?} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", free_list(coordinates))]
     Singular {
         /// Time.
         t: f64,
@@ -168,7 +168,7 @@ pub enum DynamicsError {
         coordinates: Vec<&'static str>,
     },
     /// Redundant constraints whose acceleration terms contradict the others.
-    #[error("redundant constraints {constraints:?} are inconsistent at t = {t}: acceleration residual {residual:e}")]
+    #[error("redundant constraints {constraints:?} are inconsistent at t = {t:?}: acceleration residual {residual:e}")]
     InconsistentRedundant {
         /// Time.
         t: f64,

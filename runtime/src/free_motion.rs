@@ -92,7 +92,7 @@ impl Default for FreeMotionParams {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FreeMotionError {
     /// \[S2\] needs $\det A \ne 0$.
-    #[error("mass matrix of `{model}` singular at t = {t} (pivot ratio {ratio:e}): the explicit multiplier formula needs a regular mass matrix; use the augmented solve and check that the multipliers vanish")]
+    #[error("mass matrix of `{model}` singular at t = {t:?} (pivot ratio {ratio:e}): the explicit multiplier formula needs a regular mass matrix; use the augmented solve and check that the multipliers vanish")]
     SingularMass {
         /// The model.
         model: &'static str,

@@ -139,7 +139,7 @@ impl Impact {
 pub enum ImpactError {
     /// The rows of $[J; D]$ are dependent: the impulses are not determined.
     #[error(
-        "impact at t = {t}: the constraints and contacts {} are dependent here (a singular \
+        "impact at t = {t:?}: the constraints and contacts {} are dependent here (a singular \
          configuration), so the impulses are not determined",
         names(constraints)
     )]
@@ -150,7 +150,7 @@ pub enum ImpactError {
         constraints: Vec<&'static str>,
     },
     /// The mass matrix is singular on the null space of the constraints and contacts.
-    #[error("impact at t = {t}: the mass matrix is singular on the constraints' null space (pivot ratio {ratio:e})")]
+    #[error("impact at t = {t:?}: the mass matrix is singular on the constraints' null space (pivot ratio {ratio:e})")]
     SingularMass {
         /// Time.
         t: f64,

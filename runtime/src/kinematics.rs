@@ -71,7 +71,7 @@ pub struct NewtonStats {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum KinematicsError {
     /// Newton did not converge.
-    #[error("position analysis failed at t = {t} after {iterations} iterations: residual {residual:e}, {}", if violated.is_empty() { "every constraint within the tolerance but the Newton step did not settle".to_owned() } else { format!("violated constraints {violated:?}") })]
+    #[error("position analysis failed at t = {t:?} after {iterations} iterations: residual {residual:e}, {}", if violated.is_empty() { "every constraint within the tolerance but the Newton step did not settle".to_owned() } else { format!("violated constraints {violated:?}") })]
     NewtonFailed {
         /// Time.
         t: f64,
@@ -83,7 +83,7 @@ pub enum KinematicsError {
         violated: Vec<&'static str>,
     },
     /// $C_\beta$ became singular during Newton.
-    #[error("dependent Jacobian `C_beta` is singular at t = {t}, iteration {iteration} (pivot ratio {ratio:e}); re-partition")]
+    #[error("dependent Jacobian `C_beta` is singular at t = {t:?}, iteration {iteration} (pivot ratio {ratio:e}); re-partition")]
     SingularDependent {
         /// Time.
         t: f64,
@@ -93,7 +93,7 @@ pub enum KinematicsError {
         ratio: f64,
     },
     /// $J_d$ is singular in the velocity solve.
-    #[error("dependent velocity Jacobian `J_d` is singular at t = {t} (pivot ratio {ratio:e}); re-partition")]
+    #[error("dependent velocity Jacobian `J_d` is singular at t = {t:?} (pivot ratio {ratio:e}); re-partition")]
     SingularVelocity {
         /// Time.
         t: f64,
@@ -105,7 +105,7 @@ pub enum KinematicsError {
     /// sign of $\det J_d$ differs from the reference (see
     /// [`Kinematics::dependent_sign`]), or the correction of the guess exceeds the
     /// predicted motion. Detected by the simulation: the guess was extrapolated too far.
-    #[error("position analysis at t = {t} converged on another solution branch; a shorter step is needed")]
+    #[error("position analysis at t = {t:?} converged on another solution branch; a shorter step is needed")]
     BranchSwitch {
         /// Time.
         t: f64,

@@ -98,7 +98,7 @@ pub enum Role {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PartitionError {
     /// $C_q$ is rank deficient.
-    #[error("redundant or singular holonomic constraints at t = {t}: {constraints:?} (pivot ratio {ratio:e}, rank {rank} of {rows})")]
+    #[error("redundant or singular holonomic constraints at t = {t:?}: {constraints:?} (pivot ratio {ratio:e}, rank {rank} of {rows})")]
     RedundantHolonomic {
         /// Time.
         t: f64,
@@ -112,7 +112,7 @@ pub enum PartitionError {
         rows: usize,
     },
     /// $\hat G$ is rank deficient: non-holonomic constraints depend on the others.
-    #[error("redundant or singular non-holonomic constraints at t = {t}: {constraints:?} (pivot ratio {ratio:e})")]
+    #[error("redundant or singular non-holonomic constraints at t = {t:?}: {constraints:?} (pivot ratio {ratio:e})")]
     RedundantNonholonomic {
         /// Time.
         t: f64,
@@ -122,7 +122,7 @@ pub enum PartitionError {
         ratio: f64,
     },
     /// A coordinate asked to stay independent must be dependent.
-    #[error("coordinate `{coordinate}` cannot be kept independent at t = {t}: constraints {constraints:?} can only be met by moving it (or other prescribed coordinates)")]
+    #[error("coordinate `{coordinate}` cannot be kept independent at t = {t:?}: constraints {constraints:?} can only be met by moving it (or other prescribed coordinates)")]
     PrescribedCoordinate {
         /// Time.
         t: f64,
@@ -132,7 +132,7 @@ pub enum PartitionError {
         constraints: Vec<&'static str>,
     },
     /// A coordinate whose velocity is prescribed must have a dependent velocity.
-    #[error("the velocity of `{coordinate}` cannot be prescribed at t = {t}: constraints {constraints:?} determine it (too many or inconsistent prescribed velocities)")]
+    #[error("the velocity of `{coordinate}` cannot be prescribed at t = {t:?}: constraints {constraints:?} determine it (too many or inconsistent prescribed velocities)")]
     PrescribedVelocity {
         /// Time.
         t: f64,

@@ -78,7 +78,7 @@ impl fmt::Display for Quantity {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EvalError {
     /// A value is NaN or infinite. `row`/`col` locate it (`col` only for matrices).
-    #[error("non-finite {quantity} at t = {t}: entry ({row}{}) is {value}", col.map(|c| format!(", {c}")).unwrap_or_default())]
+    #[error("non-finite {quantity} at t = {t:?}: entry ({row}{}) is {value}", col.map(|c| format!(", {c}")).unwrap_or_default())]
     NonFinite {
         /// The offending quantity.
         quantity: Quantity,

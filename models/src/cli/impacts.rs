@@ -77,7 +77,7 @@ pub fn summary(info: &Info, run: &Run, w: &mut String) {
         let _ = writeln!(
             w,
             "  t = {:<20} {:<12} impulse {:.6e}, energy lost {:.6e} J",
-            imp.t,
+            super::time(imp.t),
             imp.names.first().copied().unwrap_or(""),
             imp.impulses.first().copied().unwrap_or(0.0),
             imp.energy_lost()
@@ -91,6 +91,11 @@ pub fn summary(info: &Info, run: &Run, w: &mut String) {
             ContactEventKind::Rest => "comes to rest (impacts accumulated)",
             ContactEventKind::Release => "releases (its normal force turned tensile)",
         };
-        let _ = writeln!(w, "contact      {} {what} at t = {}", e.contact, e.t);
+        let _ = writeln!(
+            w,
+            "contact      {} {what} at t = {}",
+            e.contact,
+            super::time(e.t)
+        );
     }
 }

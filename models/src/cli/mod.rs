@@ -136,3 +136,13 @@ pub fn main() -> ExitCode {
         }
     }
 }
+
+/// A time for the reports: as written (`7.10352584272872`, `3`) unless it is so small or
+/// so large that its digits would fill the line (`1e-300`, not 300 zeros).
+pub(crate) fn time(t: f64) -> String {
+    if t == 0.0 || (1e-4..1e16).contains(&t.abs()) || !t.is_finite() {
+        format!("{t}")
+    } else {
+        format!("{t:e}")
+    }
+}

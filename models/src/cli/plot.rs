@@ -208,7 +208,7 @@ pub fn work_precision(model: &str, t_end: f64, rows: &[Row], path: &Path) -> Res
     root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
-            format!("work-precision: {model} over [0, {t_end}] s"),
+            format!("work-precision: {model} over [0, {}] s", super::time(t_end)),
             ("sans-serif", 22),
         )
         .margin(15)

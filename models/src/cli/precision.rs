@@ -25,7 +25,8 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             "is not a finite time"
         };
         return Err(usage(format!(
-            "--t-end {t_end} {what}: expected a positive finite end time"
+            "--t-end {} {what}: expected a positive finite end time",
+            super::time(t_end)
         )));
     }
     let (reference, source) = match scene.closed_form {
@@ -81,8 +82,9 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     }
     let rows = work_precision(model.as_ref(), &sweep, &reference);
     println!(
-        "work-precision of {} over [0, {t_end}] s; error = largest |final q, q' - reference| over the largest |q|, |q'| of the reference (at least 1), reference: {source}",
-        entry.name
+        "work-precision of {} over [0, {}] s; error = largest |final q, q' - reference| over the largest |q|, |q'| of the reference (at least 1), reference: {source}",
+        entry.name,
+        super::time(t_end)
     );
     if entry.stiff && !args.all_methods {
         println!(

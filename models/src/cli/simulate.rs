@@ -72,7 +72,8 @@ pub fn request<'a>(
             "is not a finite time"
         };
         return Err(usage(format!(
-            "--t-end {t_end} {what}: expected a finite end time, at least 0 (0 analyses the initial state)"
+            "--t-end {} {what}: expected a finite end time, at least 0 (0 analyses the initial state)",
+            super::time(t_end)
         )));
     }
     let mut notes = Vec::new();
@@ -84,7 +85,8 @@ pub fn request<'a>(
         let min = min_step(0.0, if t_end > 0.0 { t_end } else { 1.0 });
         if h < min {
             notes.push(format!(
-                "--step {h:e} is below the smallest step the time resolves over [0, {t_end}] s: {min:e} was used"
+                "--step {h:e} is below the smallest step the time resolves over [0, {}] s: {min:e} was used",
+                super::time(t_end)
             ));
         }
         h.max(min)
@@ -413,14 +415,14 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     let _ = writeln!(
         w,
         "span         0 to {} s{}{}",
-        req.t_end,
+        super::time(req.t_end),
         if span.is_empty() {
             String::new()
         } else {
             format!(" ({span})")
         },
         if out.error.is_some() {
-            format!(", stopped at {reached} s")
+            format!(", stopped at {} s", super::time(reached))
         } else {
             String::new()
         }
@@ -476,7 +478,7 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
             } else {
                 "final       "
             };
-            let _ = writeln!(w, "{label} t = {t}: {}", list.join(", "));
+            let _ = writeln!(w, "{label} t = {}: {}", super::time(t), list.join(", "));
         }
         None => {
             let _ = writeln!(

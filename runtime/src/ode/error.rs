@@ -29,7 +29,7 @@ impl std::fmt::Display for Quantity {
 #[derive(Debug, thiserror::Error)]
 pub enum OdeError {
     /// The step size fell below what the precision of `t` can resolve.
-    #[error("step size {h:e} too small at t = {t}")]
+    #[error("step size {h:e} too small at t = {t:?}")]
     StepSizeTooSmall {
         /// Time of the last accepted state.
         t: f64,
@@ -37,7 +37,7 @@ pub enum OdeError {
         h: f64,
     },
     /// More step attempts (accepted and rejected) since the last `reset` than allowed.
-    #[error("more than {steps} step attempts since the last reset, at t = {t}")]
+    #[error("more than {steps} step attempts since the last reset, at t = {t:?}")]
     MaxStepsExceeded {
         /// Time of the last accepted state.
         t: f64,
@@ -45,7 +45,7 @@ pub enum OdeError {
         steps: u64,
     },
     /// A NaN or an infinity in a derivative or a state.
-    #[error("non-finite {quantity} in component {component} at t = {t}")]
+    #[error("non-finite {quantity} in component {component} at t = {t:?}")]
     NonFinite {
         /// Time at which the value was produced (a stage time for a derivative).
         t: f64,
@@ -55,7 +55,7 @@ pub enum OdeError {
         quantity: Quantity,
     },
     /// The right-hand side failed; `source` is the system's own error.
-    #[error("right-hand side failed at t = {t}")]
+    #[error("right-hand side failed at t = {t:?}")]
     Rhs {
         /// Time at which the right-hand side was evaluated.
         t: f64,
@@ -88,7 +88,7 @@ pub enum OdeError {
         h: f64,
     },
     /// `t_stop` lies behind the current time in the direction of integration.
-    #[error("t_stop = {t_stop} lies behind t = {t} in the direction of integration")]
+    #[error("t_stop = {t_stop:?} lies behind t = {t:?} in the direction of integration")]
     StopBehind {
         /// Current time.
         t: f64,
@@ -96,7 +96,7 @@ pub enum OdeError {
         t_stop: f64,
     },
     /// Dense output was asked outside the last step.
-    #[error("t = {t} lies outside the last step [{t_prev}, {t_cur}]")]
+    #[error("t = {t:?} lies outside the last step [{t_prev:?}, {t_cur:?}]")]
     OutsideStep {
         /// Requested time.
         t: f64,

@@ -114,7 +114,7 @@ pub enum SimErrorKind {
     Assembly(#[from] AssemblyError),
     /// The initial positions put a contact's gap below zero by more than the
     /// consistency tolerance: the bodies start inside each other.
-    #[error("the initial state penetrates contact `{contact}` at t = {t}: its gap is {gap:e} (below -{tolerance:.1e}); start the contact touching (gap 0) or open")]
+    #[error("the initial state penetrates contact `{contact}` at t = {t:?}: its gap is {gap:e} (below -{tolerance:.1e}); start the contact touching (gap 0) or open")]
     InitialPenetration {
         /// Time.
         t: f64,
@@ -126,7 +126,7 @@ pub enum SimErrorKind {
         tolerance: f64,
     },
     /// A Newton iteration (K1 or the position projection) did not converge.
-    #[error("Newton iteration failed at t = {t} after {iterations} iterations: residual {residual:e}, {}", involved("constraints", constraints, "every residual is within the tolerance, the iteration stalled or kept landing on another solution branch"))]
+    #[error("Newton iteration failed at t = {t:?} after {iterations} iterations: residual {residual:e}, {}", involved("constraints", constraints, "every residual is within the tolerance, the iteration stalled or kept landing on another solution branch"))]
     NewtonFailed {
         /// Time.
         t: f64,
@@ -140,7 +140,7 @@ pub enum SimErrorKind {
         constraints: Vec<&'static str>,
     },
     /// A matrix became singular.
-    #[error("singular {matrix} at t = {t} (pivot ratio {ratio:e}); {}", involved("constraints", constraints, "no residual exceeds the tolerance and no constraints are nearly dependent at the last recorded state"))]
+    #[error("singular {matrix} at t = {t:?} (pivot ratio {ratio:e}); {}", involved("constraints", constraints, "no residual exceeds the tolerance and no constraints are nearly dependent at the last recorded state"))]
     Singular {
         /// Time.
         t: f64,
@@ -155,7 +155,7 @@ pub enum SimErrorKind {
     /// The augmented matrix of (E31) is singular while $J$ has full rank: the mass
     /// matrix is singular on the tangent space of the constraints (a massless
     /// coordinate that no constraint determines, for instance).
-    #[error("singular augmented matrix at t = {t} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", involved("coordinates", coordinates, "the singular direction mixes accelerations and multipliers"))]
+    #[error("singular augmented matrix at t = {t:?} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", involved("coordinates", coordinates, "the singular direction mixes accelerations and multipliers"))]
     SingularMass {
         /// Time.
         t: f64,
@@ -165,7 +165,7 @@ pub enum SimErrorKind {
         coordinates: Vec<&'static str>,
     },
     /// The step size fell below what the precision of `t` resolves.
-    #[error("step size {h:e} too small at t = {t}")]
+    #[error("step size {h:e} too small at t = {t:?}")]
     StepSizeTooSmall {
         /// Time of the last accepted state.
         t: f64,
@@ -173,7 +173,7 @@ pub enum SimErrorKind {
         h: f64,
     },
     /// More step attempts than allowed.
-    #[error("more than {steps} step attempts, at t = {t}")]
+    #[error("more than {steps} step attempts, at t = {t:?}")]
     MaxSteps {
         /// Time of the last accepted state.
         t: f64,
@@ -181,7 +181,7 @@ pub enum SimErrorKind {
         steps: u64,
     },
     /// A NaN or an infinity.
-    #[error("non-finite value at t = {t} in the {source_of}")]
+    #[error("non-finite value at t = {t:?} in the {source_of}")]
     NonFinite {
         /// Time.
         t: f64,
@@ -356,7 +356,7 @@ impl fmt::Display for SimError {
         if let Some((t, _, _)) = self.partial.final_state() {
             write!(
                 f,
-                " ({} rows kept, the last at t = {t})",
+                " ({} rows kept, the last at t = {t:?})",
                 self.partial.trajectory.len()
             )?;
         }
