@@ -181,7 +181,7 @@ fn rtol_above_one_is_refused() {
 /// assembly, a failed run and a write error, each with an `error` entry.
 #[test]
 fn json_is_one_object_for_every_exit_code() {
-    let cases: [(&[&str], i32, &str); 8] = [
+    let cases: [(&[&str], i32, &str); 11] = [
         (&["simulate", "pendulum", "--set", "zz=1"], 2, "usage"),
         (&["simulate", "pendulum", "--bogus"], 2, "usage"),
         (&["linearize", "pendulum", "--set", "zz=1"], 2, "usage"),
@@ -212,6 +212,24 @@ fn json_is_one_object_for_every_exit_code() {
             &["simulate", "pendulum_floor", "--set", "depth=1.6"],
             1,
             "initial_penetration",
+        ),
+        // A negative mass or moment of inertia: a kinetic energy negative along the
+        // constraints (the runs went on, the pendulum's motion unchanged and its
+        // energy of the wrong sign).
+        (
+            &["simulate", "pendulum", "--set", "m=-1"],
+            1,
+            "negative_mass",
+        ),
+        (
+            &["simulate", "andrews", "--set", "i1=-1"],
+            1,
+            "negative_mass",
+        ),
+        (
+            &["simulate", "free_body", "--set", "izz=-1"],
+            1,
+            "negative_mass",
         ),
     ];
     for (args, code, kind) in cases {

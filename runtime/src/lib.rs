@@ -49,6 +49,7 @@ mod ext;
 pub mod flex;
 pub mod free_motion;
 mod impact;
+pub mod inertia;
 mod joint_reactions;
 mod kinematics;
 mod linalg;

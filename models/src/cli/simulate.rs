@@ -228,6 +228,7 @@ fn kind_name(kind: &SimErrorKind) -> &'static str {
         SimErrorKind::InitialLength { .. } => "initial_length",
         SimErrorKind::Assembly(_) => "assembly",
         SimErrorKind::InitialPenetration { .. } => "initial_penetration",
+        SimErrorKind::NegativeMass { .. } => "negative_mass",
         SimErrorKind::NewtonFailed { .. } => "newton_failed",
         SimErrorKind::Singular { .. } => "singular",
         SimErrorKind::SingularMass { .. } => "singular_mass",

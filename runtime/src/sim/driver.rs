@@ -323,6 +323,19 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         sys.point.invalidate();
         overridden
     };
+    // A mass matrix with a negative direction has no physical motion, and nothing
+    // later stops it (the general solve is regular): checked once, here.
+    match crate::inertia::negative_direction(mech, t0, &q, &qd) {
+        Ok(None) => {}
+        Ok(Some(found)) => {
+            return Err(empty(SimErrorKind::NegativeMass {
+                t: t0,
+                coordinate: info.coordinates[found.coordinate].name,
+                ratio: found.ratio,
+            }))
+        }
+        Err(e) => return Err(empty(SimErrorKind::Analysis(e.into()))),
+    }
     sys.point.q.copy_from_slice(&q);
     sys.point.qd.copy_from_slice(&qd);
     sys.point.redundant = sys.point.fit_partition();

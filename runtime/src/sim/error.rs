@@ -125,6 +125,18 @@ pub enum SimErrorKind {
         /// The largest penetration accepted as touching.
         tolerance: f64,
     },
+    /// The mass matrix at the initial state has a direction of negative kinetic
+    /// energy ([`crate::inertia`]): the model has no physical motion.
+    #[error("the kinetic energy is negative in a direction of `{coordinate}` at t = {t:?}: the mass matrix is not positive semi-definite (pivot {ratio:.3e} of its diagonal); a negative mass or moment of inertia, or a kinetic energy written with a wrong sign?")]
+    NegativeMass {
+        /// Time.
+        t: f64,
+        /// The coordinate whose pivot is negative (the direction involves it and
+        /// coordinates before it).
+        coordinate: &'static str,
+        /// The pivot over its diagonal.
+        ratio: f64,
+    },
     /// A Newton iteration (K1 or the position projection) did not converge.
     #[error("Newton iteration failed at t = {t:?} after {iterations} iterations: residual {residual:e}, {}", involved("constraints", constraints, "every residual is within the tolerance, the iteration stalled or kept landing on another solution branch"))]
     NewtonFailed {
@@ -207,6 +219,7 @@ impl SimErrorKind {
     pub fn t(&self) -> Option<f64> {
         match self {
             Self::NewtonFailed { t, .. }
+            | Self::NegativeMass { t, .. }
             | Self::Singular { t, .. }
             | Self::SingularMass { t, .. }
             | Self::StepSizeTooSmall { t, .. }

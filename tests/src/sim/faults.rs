@@ -56,6 +56,48 @@ fn inconsistent_initial_condition_is_an_assembly_error() {
     ));
 }
 
+/// A negative mass: the pendulum's kinetic energy −(ẋ² + ẏ²)/2 is negative along the
+/// rod's tangent, a typed error at the start that names the coordinate; a mass
+/// matrix singular off the constraints (free_body's Euler parameters, `M θ = 0`) is
+/// not one.
+#[test]
+fn a_negative_mass_is_a_typed_error_at_the_start() {
+    let mut model = pendulum::Model::default();
+    let m = model.info().parameter_index("m").unwrap();
+    model.set_parameter(m, -1.0);
+    for formulation in Formulation::ALL {
+        let err = Simulation::new(&model)
+            .formulation(formulation)
+            .run(1.0)
+            .unwrap_err();
+        match err.kind {
+            SimErrorKind::NegativeMass {
+                t,
+                coordinate,
+                ratio,
+            } => {
+                assert_eq!(t, 0.0);
+                // At (1, 0) the tangent is y's direction.
+                assert_eq!(coordinate, "y");
+                assert!(ratio < -0.5, "{ratio}");
+            }
+            ref other => panic!("{formulation:?}: {other}"),
+        }
+        assert!(err.partial.trajectory.is_empty());
+    }
+    let body = pfaff_models::free_body::Model::default();
+    assert!(Simulation::new(&body).run(0.1).is_ok());
+    assert_eq!(
+        pfaff::inertia::negative_direction(
+            &body,
+            0.0,
+            &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            &[0.0; 7]
+        ),
+        Ok(None)
+    );
+}
+
 #[test]
 fn nan_parameter_is_a_non_finite_error() {
     let mut model = pendulum::Model::default();
