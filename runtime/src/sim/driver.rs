@@ -334,7 +334,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 ratio: found.ratio,
             }))
         }
-        Err(e) => return Err(empty(SimErrorKind::Analysis(e.into()))),
+        Err(e) => return Err(empty(SimErrorKind::from_eval(e))),
     }
     sys.point.q.copy_from_slice(&q);
     sys.point.qd.copy_from_slice(&qd);
