@@ -226,6 +226,15 @@ pub enum LinearizeError {
     /// Evaluation failed.
     #[error(transparent)]
     Eval(#[from] EvalError),
+    /// The mass matrix at the operating point has a direction of negative kinetic
+    /// energy ([`crate::inertia`]): the linearization would describe no physical motion.
+    #[error("the kinetic energy is negative in a direction of `{coordinate}` at the operating point: the mass matrix is not positive semi-definite (pivot {ratio:.3e} of its diagonal); a negative mass or moment of inertia?")]
+    NegativeMass {
+        /// The coordinate whose pivot is negative.
+        coordinate: &'static str,
+        /// The pivot over its diagonal.
+        ratio: f64,
+    },
     /// The eigenvalue decomposition did not converge.
     #[error("eigenvalue decomposition of the {dim}x{dim} state matrix did not converge")]
     Eigen {
@@ -457,6 +466,12 @@ pub fn linearize_with<M: Mechanism + ?Sized>(
                 })
         })
         .collect::<Result<_, _>>()?;
+    if let Some(found) = crate::inertia::negative_direction(mech, t, q, qd)? {
+        return Err(LinearizeError::NegativeMass {
+            coordinate: info.coordinates[found.coordinate].name,
+            ratio: found.ratio,
+        });
+    }
     let mut ws = Workspace::new(info)?;
     let prefs = Preferences {
         coordinates: &dropped,

@@ -165,3 +165,29 @@ fn unknown_ignorable_coordinate() {
         "unknown coordinate `psi` among the ignorable ones, expected one of [\"x\", \"y\", \"phi\"]"
     );
 }
+
+/// A negative mass: the hanging pendulum with m = −1 has the kinetic energy
+/// −(ẋ² + ẏ²)/2, negative along the rod's tangent (x at the bottom); the
+/// linearization refuses it instead of describing a motion no mechanism has.
+#[test]
+fn a_negative_mass_is_refused() {
+    let mut model = pendulum::Model::default();
+    let m = model.info().parameter_index("m").unwrap();
+    model.set_parameter(m, -1.0);
+    let err = linearize(
+        &model,
+        0.0,
+        &[0.0, -1.0],
+        &[0.0, 0.0],
+        &[],
+        &LinearizeParams::default(),
+    )
+    .unwrap_err();
+    match err {
+        LinearizeError::NegativeMass { coordinate, ratio } => {
+            assert_eq!(coordinate, "x");
+            assert!(ratio < -0.5, "{ratio}");
+        }
+        other => panic!("{other}"),
+    }
+}
