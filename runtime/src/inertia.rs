@@ -46,6 +46,15 @@ pub struct NegativeDirection {
     pub ratio: f64,
 }
 
+/// What a negative pivot (`ratio` of its diagonal) means, for the errors that report
+/// one.
+pub(crate) fn explain(ratio: f64) -> String {
+    format!(
+        "the mass matrix is not positive semi-definite (pivot {ratio:.3e} of its diagonal); \
+         a negative mass or moment of inertia, or a kinetic energy written with a wrong sign?"
+    )
+}
+
 /// Whether the mass matrix at `(t, q)` has a direction of negative kinetic energy
 /// (module docs); `None` when every pivot is clearly positive, when a pivot is too
 /// small to tell, and above [`LIMIT`] coordinates.

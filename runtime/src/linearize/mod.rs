@@ -228,7 +228,7 @@ pub enum LinearizeError {
     Eval(#[from] EvalError),
     /// The mass matrix at the operating point has a direction of negative kinetic
     /// energy ([`crate::inertia`]): the linearization would describe no physical motion.
-    #[error("the kinetic energy is negative in a direction of `{coordinate}` at the operating point: the mass matrix is not positive semi-definite (pivot {ratio:.3e} of its diagonal); a negative mass or moment of inertia?")]
+    #[error("the kinetic energy is negative in a direction of `{coordinate}` at the operating point: {}", crate::inertia::explain(*ratio))]
     NegativeMass {
         /// The coordinate whose pivot is negative.
         coordinate: &'static str,

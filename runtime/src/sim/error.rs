@@ -127,7 +127,7 @@ pub enum SimErrorKind {
     },
     /// The mass matrix at the initial state has a direction of negative kinetic
     /// energy ([`crate::inertia`]): the model has no physical motion.
-    #[error("the kinetic energy is negative in a direction of `{coordinate}` at t = {t:?}: the mass matrix is not positive semi-definite (pivot {ratio:.3e} of its diagonal); a negative mass or moment of inertia, or a kinetic energy written with a wrong sign?")]
+    #[error("the kinetic energy is negative in a direction of `{coordinate}` at t = {t:?}: {}", crate::inertia::explain(*ratio))]
     NegativeMass {
         /// Time.
         t: f64,
