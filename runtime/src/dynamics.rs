@@ -168,7 +168,7 @@ pub enum DynamicsError {
         coordinates: Vec<&'static str>,
     },
     /// Redundant constraints whose acceleration terms contradict the others.
-    #[error("redundant constraints {constraints:?} are inconsistent at t = {t:?}: acceleration residual {residual:e}")]
+    #[error("redundant constraints {constraints:?} are inconsistent at t = {t:?}: acceleration residual {residual:e}{}", vanishing_note(vanishing))]
     InconsistentRedundant {
         /// Time.
         t: f64,
@@ -176,6 +176,10 @@ pub enum DynamicsError {
         constraints: Vec<&'static str>,
         /// $\max_D |J_D\ddot q - \gamma_D|$.
         residual: f64,
+        /// Those of `constraints` whose rows of $J$ are zero there: a constraint whose
+        /// gradient vanishes where it holds (`x² + y² − l²` with `l = 0`) exerts no
+        /// force, and is redundant because it is degenerate, not because others imply it.
+        vanishing: Vec<&'static str>,
     },
     /// The sparse symbolic factorization failed.
     #[error("sparse symbolic factorization of the augmented matrix of `{model}` failed: {reason}")]
@@ -757,14 +761,35 @@ impl Dynamics {
             }
             // (A fresh split is not checked for independent rows.)
             Err(SplitFailure::Inconsistent(residual) | SplitFailure::Independent(residual)) => {
+                let vanishing = self
+                    .redundant
+                    .iter()
+                    .zip(self.redundant_constraints())
+                    .filter(|&(&r, _)| ws.jacobian[r * n..(r + 1) * n].iter().all(|&a| a == 0.0))
+                    .map(|(_, name)| name)
+                    .collect();
                 Err(DynamicsError::InconsistentRedundant {
                     t,
                     constraints: self.redundant_constraints().collect(),
                     residual,
+                    vanishing,
                 })
             }
         }
     }
+}
+
+/// The clause of [`DynamicsError::InconsistentRedundant`]'s message on constraints
+/// whose gradient vanishes (none: empty).
+fn vanishing_note(vanishing: &[&'static str]) -> String {
+    if vanishing.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; the gradients of {vanishing:?} are zero there: a constraint whose gradient \
+         vanishes where it holds exerts no force (a parameter at a degenerate value, \
+         such as a zero length?)"
+    )
 }
 
 impl Split {

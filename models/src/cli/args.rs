@@ -42,7 +42,7 @@ pub enum Command {
 /// How the constrained equations become an ODE.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum FormulationArg {
-    /// Coordinate partitioning: integrate the independent coordinates only (no drift).
+    /// Coordinate partitioning in the tangent-space chart of the last step: every evaluation's positions and velocities corrected onto the constraints (no drift).
     Partitioning,
     /// Index-1 equations, positions and velocities projected after each step.
     Projection,

@@ -116,6 +116,40 @@ fn nan_parameter_is_a_non_finite_error() {
     );
 }
 
+/// A zero rod: `x² + y² − l²` with `l = 0` holds only at the pivot, where its gradient
+/// `(2x, 2y)` vanishes, so it exerts no force and gravity pulls the bob off it. Every
+/// formulation ends in the typed error of an inconsistent redundant row, which names
+/// the rod as degenerate (its gradient zero), not as implied by other constraints.
+#[test]
+fn a_degenerate_constraint_is_named_as_such() {
+    let mut model = pendulum::Model::default();
+    let l = model.info().parameter_index("l").unwrap();
+    model.set_parameter(l, 0.0);
+    for formulation in Formulation::ALL {
+        let err = Simulation::new(&model)
+            .formulation(formulation)
+            .run(1.0)
+            .unwrap_err();
+        match &err.kind {
+            SimErrorKind::Analysis(pfaff::Error::Dynamics(
+                pfaff::DynamicsError::InconsistentRedundant {
+                    constraints,
+                    vanishing,
+                    ..
+                },
+            )) => {
+                assert_eq!(constraints, &["rod"], "{}", formulation.name());
+                assert_eq!(vanishing, &["rod"], "{}", formulation.name());
+                assert!(
+                    err.to_string().contains("gradients of [\"rod\"] are zero"),
+                    "{err}"
+                );
+            }
+            other => panic!("{}: {other}", formulation.name()),
+        }
+    }
+}
+
 #[test]
 fn nan_during_the_run_keeps_the_partial_trajectory() {
     let model = fragile_pendulum::Model::default();

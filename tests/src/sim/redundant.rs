@@ -218,6 +218,7 @@ fn an_inconsistent_redundant_set_is_still_an_error() {
                     ref constraints,
                     residual,
                     t,
+                    ref vanishing,
                 },
             )) = err.kind
             else {
@@ -226,6 +227,8 @@ fn an_inconsistent_redundant_set_is_still_an_error() {
             // The typed error carries the time its message names.
             assert_eq!(err.t(), Some(t));
             assert!(!constraints.is_empty() && constraints.iter().all(|c| c.ends_with("_y")));
+            // Dependent rows, not degenerate ones: none of their gradients vanishes.
+            assert!(vanishing.is_empty(), "{vanishing:?}");
             // ẋ²|1/l − 1/l₃| = 0.0833 m/s², of order 1 against the tolerance.
             assert!(residual > 1e-2, "{residual:e}");
         }
