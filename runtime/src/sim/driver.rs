@@ -672,13 +672,15 @@ const MAX_STEP_BACKS: u32 = 8;
 
 /// Whether a step's failure can be the one of a state next to a rank drop of $C_q$:
 /// the dropped rows' check failing at every attempt (reported as such, or as the step
-/// size's underflow that the retries end in), or the position iteration stalling there
-/// on the singular Jacobian.
+/// size's underflow that the retries end in), the position iteration stalling there
+/// on the singular Jacobian, or the augmented matrix singular there (Bricard's loop
+/// near $(q_1, q_2) = (\pi, -\pi)$ at rtol 1e-3).
 fn rank_drop_failure(kind: &SimErrorKind) -> bool {
     matches!(
         kind,
         SimErrorKind::StepSizeTooSmall { .. }
             | SimErrorKind::NewtonFailed { .. }
+            | SimErrorKind::SingularMass { .. }
             | SimErrorKind::Analysis(crate::Error::Dynamics(
                 crate::DynamicsError::InconsistentRedundant { .. }
             ))
