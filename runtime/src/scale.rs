@@ -118,6 +118,13 @@ pub(crate) fn at_rounding_floor(c: &[f64], jacobian: &[f64], n: usize, size: f64
     all_met(c, jacobian, n, ROUNDING_FLOOR, size.max(1.0))
 }
 
+/// The distance from the constraints within which [`at_rounding_floor`] holds, for
+/// coordinates of size `size`: $64\,\varepsilon \max(s_q, 1)$ (a Newton update of
+/// about that size moves by the rounding of $C$).
+pub(crate) fn rounding_floor_distance(size: f64) -> f64 {
+    ROUNDING_FLOOR * size.max(1.0)
+}
+
 /// The relative tolerance of [`at_rounding_floor`].
 const ROUNDING_FLOOR: f64 = 64.0 * f64::EPSILON;
 
