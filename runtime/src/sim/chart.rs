@@ -66,7 +66,7 @@ pub(crate) const KAPPA: f64 = 0.03;
 /// own error. The dropped rows are dependent on the manifold only, so at a state
 /// $10^{-4}$ off it (0.03 of rtol 1e-3) `bricard`'s accelerations were off by order
 /// one, and its DOPRI5 runs gained 28 J of 32 at rtol 1e-3 where projection kept the
-/// energy to 2e-4 J; with this fraction, 2e-3 J (ARCHITECTURE.md, "Through a rank
+/// energy to 2e-4 J; with this fraction, 6e-4 J (ARCHITECTURE.md, "Through a rank
 /// drop").
 const KAPPA_REDUNDANT: f64 = 1e-6;
 
@@ -663,11 +663,11 @@ impl Chart {
                 if measured.is_nan() || measured >= DIVERGENCE {
                     // Stagnant with C at its rounding floor (which follows the size of
                     // the geometry, not of q: a linkage whose angles start at 0) as
-                    // `scale::at_rounding_floor` accepts it, or with the ordinary fraction
-                    // met where a smaller one was asked for (KAPPA_REDUNDANT): the ratio
-                    // of updates at round-off is noise, not a divergence. Near a rank
-                    // drop of the kept rows such updates are large, C is not.
-                    if weighted <= KAPPA || self.maps.at_rounding_floor(residual, size) {
+                    // `scale::at_rounding_floor` accepts it: the ratio of updates at
+                    // round-off is noise, not a divergence. KAPPA_REDUNDANT asks for
+                    // updates that small; near a rank drop of the kept rows they are
+                    // large (1e-13), C is not.
+                    if self.maps.at_rounding_floor(residual, size) {
                         return Ok(iteration + 1);
                     }
                     return Err(ChartFailure::Newton {
