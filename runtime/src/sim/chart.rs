@@ -628,6 +628,7 @@ impl Chart {
         } else {
             KAPPA
         };
+        let row = p.row;
         let mut previous: Option<f64> = None;
         for iteration in 0..=MAX_ITERATIONS {
             p.constraints(t)?;
@@ -676,8 +677,9 @@ impl Chart {
                     });
                 }
                 rate = measured;
-                // A rate measured on updates at round-off is noise.
-                if step > 100.0 * floor && distance > 0.0 {
+                // A rate measured on updates at round-off is noise; one measured on
+                // an output row is not learned (`Point::row`).
+                if step > 100.0 * floor && distance > 0.0 && !row {
                     self.rate_per_distance = Some(measured / distance);
                 }
             }

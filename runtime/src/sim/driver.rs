@@ -521,7 +521,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             while next_out < times.len() && times[next_out] < te {
                 let to = times[next_out];
                 check!(stepper.interpolate(to, &mut yout).map_err(ode));
-                check!(rec.sys.keep(to, &yout));
+                check!(rec.sys.keep_row(to, &yout));
                 check!(rec.record(to));
                 next_out += 1;
             }
@@ -547,7 +547,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 while next_out < times.len() && times[next_out] < found.t() {
                     let to = times[next_out];
                     check!(stepper.interpolate(to, &mut yout).map_err(ode));
-                    check!(rec.sys.keep(to, &yout));
+                    check!(rec.sys.keep_row(to, &yout));
                     check!(rec.record(to));
                     next_out += 1;
                 }
@@ -647,7 +647,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         while next_out < times.len() && times[next_out] <= t {
             let to = times[next_out];
             check!(stepper.interpolate(to, &mut yout).map_err(ode));
-            check!(rec.sys.keep(to, &yout));
+            check!(rec.sys.keep_row(to, &yout));
             check!(rec.record(to));
             next_out += 1;
         }

@@ -169,6 +169,11 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// Whether `lu_h` holds the factor of the last position update of a projection
     /// whose projected rows are all holonomic (see [`Point::project`]).
     position_factor: bool,
+    /// Whether the state being corrected is an output row (an interpolated state the
+    /// integration does not continue from): its correction reads nothing the previous
+    /// evaluations left and teaches the integration nothing, so that a row is a
+    /// function of the interpolant alone, whatever rows came before it.
+    pub(crate) row: bool,
     lu_v: SmallCholesky,
     /// The products of the Gram matrices of `lu_h` (the holonomic rows of `rows`) and
     /// `lu_v` (all of `rows`) the sparsity of $J$ leaves (see [`GramPlan`]).
@@ -254,6 +259,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             mu: vec![0.0; m],
             lu_h: SmallCholesky::new(mh),
             position_factor: false,
+            row: false,
             lu_v: SmallCholesky::new(m),
             gram_h: GramPlan::default(),
             gram_v: GramPlan::default(),
@@ -1027,8 +1033,10 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         let eval = SimErrorKind::from_eval;
         // M of the integrator's last evaluation: at the kept state for DOP853, DOPRI5
         // and Adams, at a stage of the step for the others (a metric as good, and no
-        // evaluation of its own); the terms at the kept state when none is held.
-        if self.terms == 0 {
+        // evaluation of its own); the terms at the kept state when none is held, and
+        // for an output row (the last evaluation there is the previous row's record,
+        // and an interpolant off the manifold would land where that row was).
+        if self.terms == 0 || self.row {
             self.dynamics_terms(t)?;
         } else {
             self.check_terms(t)?;

@@ -99,6 +99,16 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
         Ok(self.form.correction())
     }
 
+    /// [`keep`](Self::keep) for an output row: an interpolated state the integration
+    /// does not continue from, corrected without reading or changing what the run's
+    /// evaluations left (see `Point::row`).
+    pub fn keep_row(&mut self, t: f64, y: &[f64]) -> Result<Correction, SimErrorKind> {
+        self.point.row = true;
+        let kept = self.keep(t, y);
+        self.point.row = false;
+        kept
+    }
+
     /// The typed failure of the last evaluation that failed.
     pub fn take_failure(&mut self) -> Option<SimErrorKind> {
         self.failure.take()

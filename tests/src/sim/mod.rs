@@ -16,6 +16,7 @@ mod projection;
 mod proportionality;
 mod redundant;
 mod robustness;
+mod rows;
 mod sleigh;
 mod slider_crank;
 mod solve;
