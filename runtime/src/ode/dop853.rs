@@ -157,9 +157,10 @@ impl Dp853 {
         sys: &mut S,
         h: f64,
     ) -> Result<(), OdeError> {
-        for s in 13..16 {
-            self.stage(st, sys, s, h)?;
-        }
+        sys.aside(true);
+        let stages = (13..16).try_for_each(|s| self.stage(st, sys, s, h));
+        sys.aside(false);
+        stages?;
         let [c1, c2, c3, c4, rest @ ..] = &mut self.cont;
         for i in 0..st.y.len() {
             let ydiff = st.y_new[i] - st.y[i];

@@ -53,6 +53,13 @@ pub trait OdeSystem {
     /// keeps may compute with that evaluation what it reads there next. The default
     /// does nothing.
     fn step_end_next(&mut self) {}
+
+    /// Told before (`true`) and after (`false`) evaluations that are not part of the
+    /// solution, made only for the interpolant (DOP853's dense stages, computed on
+    /// the steps where the caller interpolates): a system that learns from its
+    /// evaluations (a contraction rate) should not learn from these, so that the
+    /// steps do not depend on where the caller interpolates. The default does nothing.
+    fn aside(&mut self, _on: bool) {}
 }
 
 /// A failure reported by [`OdeSystem::rhs`], carrying the system's own typed error.

@@ -174,6 +174,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// evaluations left and teaches the integration nothing, so that a row is a
     /// function of the interpolant alone, whatever rows came before it.
     pub(crate) row: bool,
+    /// $M$ of the evaluation at the state a step ends in, and its time
+    /// ([`hold_metric`](Self::hold_metric)): the metric of that step's projection.
+    metric: Vec<f64>,
+    metric_t: Option<f64>,
     lu_v: SmallCholesky,
     /// The products of the Gram matrices of `lu_h` (the holonomic rows of `rows`) and
     /// `lu_v` (all of `rows`) the sparsity of $J$ leaves (see [`GramPlan`]).
@@ -260,6 +264,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             lu_h: SmallCholesky::new(mh),
             position_factor: false,
             row: false,
+            metric: Vec::new(),
+            metric_t: None,
             lu_v: SmallCholesky::new(m),
             gram_h: GramPlan::default(),
             gram_v: GramPlan::default(),
@@ -990,6 +996,18 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// update's $J J^\mathsf{T}$ ([`chord_velocities`](Self::chord_velocities)), which
     /// converges to the same orthogonal projection at the corrected positions: one
     /// Gram matrix per projection.
+    /// Holds $M$ of the evaluation just made, at the state a step ends in (DOP853's
+    /// and DOPRI5's last stage, [`OdeSystem::step_end_next`](crate::ode::OdeSystem)), as
+    /// the metric of the step's projection at `t`
+    /// ([`project_in_mass_metric`](Self::project_in_mass_metric)): DOP853's dense
+    /// stages, evaluated after it on the steps where the run interpolates, would
+    /// otherwise leave theirs, and the step would depend on where the rows are.
+    pub(crate) fn hold_metric(&mut self, t: f64) {
+        self.metric.clear();
+        self.metric.extend_from_slice(&self.ws.mass_values);
+        self.metric_t = Some(t);
+    }
+
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if self.project_in_mass_metric(t)? {
             return Ok(());
@@ -1036,9 +1054,12 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // evaluation of its own); the terms at the kept state when none is held, and
         // for an output row (the last evaluation there is the previous row's record,
         // and an interpolant off the manifold would land where that row was).
+        // The metric held at the step's last stage (`hold_metric`) when the state is
+        // that stage's.
+        let held = self.metric_t.take() == Some(t) && !self.row;
         if self.terms == 0 || self.row {
             self.dynamics_terms(t)?;
-        } else {
+        } else if !held {
             self.check_terms(t)?;
         }
         let tol = self.newton.tolerance;
@@ -1070,7 +1091,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             let rows = &mut self.solution_scratch[n..];
             rows[..mh].copy_from_slice(c);
             rows[mh..].fill(0.0);
-            if !self.mass_metric_update(true) {
+            if !self.mass_metric_update(true, held) {
                 return Ok(false);
             }
             self.newton_iterations += 1;
@@ -1085,7 +1106,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // (`Run::monitors`, the largest velocity violation).
         self.velocity_residuals(t).map_err(eval)?;
         self.solution_scratch[n..].copy_from_slice(&self.vel);
-        Ok(self.mass_metric_update(false))
+        Ok(self.mass_metric_update(false, held))
     }
 
     /// One update of [`project_in_mass_metric`](Self::project_in_mass_metric): with the
@@ -1094,7 +1115,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// workspace), and $\Delta$ added to the positions (`positions`) or to the
     /// velocities. `false`, with nothing changed, when the solve declines or its
     /// result is not finite.
-    fn mass_metric_update(&mut self, positions: bool) -> bool {
+    fn mass_metric_update(&mut self, positions: bool, held: bool) -> bool {
         let n = self.info.nq();
         let x = &mut self.solution_scratch;
         x[..n].fill(0.0);
@@ -1102,7 +1123,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             *r = -*r;
         }
         let ws = &self.ws;
-        let terms = (&ws.mass_values[..], &ws.cq_values[..], &ws.g_values[..]);
+        let mass = if held { &self.metric } else { &ws.mass_values };
+        let terms = (&mass[..], &ws.cq_values[..], &ws.g_values[..]);
         if !self.dynamics.solve_unchecked(self.mech, terms, x) || !all_finite(x) {
             return false;
         }

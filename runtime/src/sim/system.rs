@@ -34,6 +34,10 @@ pub(crate) struct System<'a, M: Mechanism + ?Sized> {
     pub form: AnyForm,
     /// Recoverable failures since the last accepted step.
     retries: u32,
+    /// Whether the next evaluation is at the state the step ends in
+    /// ([`OdeSystem::step_end_next`]): projection holds its $M$ for the step's
+    /// correction (`Point::hold_metric`).
+    step_end: bool,
     /// The failure of the last evaluation that failed.
     failure: Option<SimErrorKind>,
     /// Contacts, impacts and resting contacts (models with contacts only).
@@ -63,6 +67,7 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
             point: Point::new(mech, dynamics, kin)?,
             form: AnyForm::new(formulation, n, m, mh, tolerances),
             retries: 0,
+            step_end: false,
             failure: None,
             contacts: super::contacts::Contacts::new(info, tolerances.0)?,
         })
@@ -125,12 +130,16 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
     /// in a row the failure ends the run.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.point.q.len();
+        let step_end = std::mem::take(&mut self.step_end);
         let r = self
             .form
             .reconstruct(&mut self.point, t, y)
             .and_then(|()| self.accelerations(t));
         match r {
             Ok(()) => {
+                if step_end && matches!(self.form, AnyForm::Projected(_)) {
+                    self.point.hold_metric(t);
+                }
                 dy[..n].copy_from_slice(&self.point.qd);
                 dy[n..].copy_from_slice(self.point.qdd());
                 Ok(())
@@ -153,6 +162,13 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
     /// a call of its own would evaluate them again).
     fn step_end_next(&mut self) {
         self.point.constraints_next = true;
+        self.step_end = true;
+    }
+
+    /// Evaluations for the interpolant only are corrected like an output row's
+    /// (`Point::row`): they teach the formulation nothing.
+    fn aside(&mut self, on: bool) {
+        self.point.row = on;
     }
 }
 
@@ -320,5 +336,9 @@ impl<M: Mechanism + ?Sized> OdeSystem for StateSpace<'_, M> {
 
     fn step_end_next(&mut self) {
         self.0.step_end_next();
+    }
+
+    fn aside(&mut self, on: bool) {
+        self.0.aside(on);
     }
 }
