@@ -678,7 +678,7 @@ impl Chart {
                 }
                 rate = measured;
                 // A rate measured on updates at round-off is noise; one measured on
-                // an output row is not learned (`Point::row`).
+                // an output row or a dense stage is not learned (`Point::row`).
                 if step > 100.0 * floor && distance > 0.0 && !row {
                     self.rate_per_distance = Some(measured / distance);
                 }

@@ -170,9 +170,10 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// whose projected rows are all holonomic (see [`Point::project`]).
     position_factor: bool,
     /// Whether the state being corrected is an output row (an interpolated state the
-    /// integration does not continue from): its correction reads nothing the previous
-    /// evaluations left and teaches the integration nothing, so that a row is a
-    /// function of the interpolant alone, whatever rows came before it.
+    /// integration does not continue from) or one of DOP853's dense stages
+    /// ([`OdeSystem::aside`](crate::ode::OdeSystem)): its correction reads nothing the
+    /// previous evaluations left and teaches the integration nothing, so that a row is
+    /// a function of the interpolant alone and the steps do not depend on the rows.
     pub(crate) row: bool,
     /// $M$ of the evaluation at the state a step ends in, and its time
     /// ([`hold_metric`](Self::hold_metric)): the metric of that step's projection.
@@ -983,6 +984,18 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
+    /// Holds $M$ of the evaluation just made, at the state a step ends in (DOP853's
+    /// and DOPRI5's last stage, [`OdeSystem::step_end_next`](crate::ode::OdeSystem)), as
+    /// the metric of the step's projection at `t`
+    /// ([`project_in_mass_metric`](Self::project_in_mass_metric)): DOP853's dense
+    /// stages, evaluated after it on the steps where the run interpolates, would
+    /// otherwise leave theirs, and the step would depend on where the rows are.
+    pub(crate) fn hold_metric(&mut self, t: f64) {
+        self.metric.clear();
+        self.metric.extend_from_slice(&self.ws.mass_values);
+        self.metric_t = Some(t);
+    }
+
     /// Projection onto the constraint manifold, in the metric of the mass matrix where
     /// the model's generated solve of the augmented system serves
     /// ([`project_in_mass_metric`](Self::project_in_mass_metric)), else (no generated
@@ -996,18 +1009,6 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// update's $J J^\mathsf{T}$ ([`chord_velocities`](Self::chord_velocities)), which
     /// converges to the same orthogonal projection at the corrected positions: one
     /// Gram matrix per projection.
-    /// Holds $M$ of the evaluation just made, at the state a step ends in (DOP853's
-    /// and DOPRI5's last stage, [`OdeSystem::step_end_next`](crate::ode::OdeSystem)), as
-    /// the metric of the step's projection at `t`
-    /// ([`project_in_mass_metric`](Self::project_in_mass_metric)): DOP853's dense
-    /// stages, evaluated after it on the steps where the run interpolates, would
-    /// otherwise leave theirs, and the step would depend on where the rows are.
-    pub(crate) fn hold_metric(&mut self, t: f64) {
-        self.metric.clear();
-        self.metric.extend_from_slice(&self.ws.mass_values);
-        self.metric_t = Some(t);
-    }
-
     pub fn project(&mut self, t: f64) -> Result<(), SimErrorKind> {
         if self.project_in_mass_metric(t)? {
             return Ok(());
@@ -1039,6 +1040,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// in [`MASS_UPDATES`](Self::MASS_UPDATES) updates, for the orthogonal projection
     /// to finish from where it stopped.
     fn project_in_mass_metric(&mut self, t: f64) -> Result<bool, SimErrorKind> {
+        // A held metric serves this correction only.
+        let held_t = self.metric_t.take();
         let info = self.info;
         let (n, mh, m) = (info.nq(), info.nh(), info.nh() + info.nnh());
         if m == 0
@@ -1056,7 +1059,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // and an interpolant off the manifold would land where that row was).
         // The metric held at the step's last stage (`hold_metric`) when the state is
         // that stage's.
-        let held = self.metric_t.take() == Some(t) && !self.row;
+        let held = held_t == Some(t) && !self.row;
         if self.terms == 0 || self.row {
             self.dynamics_terms(t)?;
         } else if !held {
