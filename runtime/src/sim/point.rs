@@ -984,12 +984,13 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         Ok(())
     }
 
-    /// Holds $M$ of the evaluation just made, at the state a step ends in (DOP853's
-    /// and DOPRI5's last stage, [`OdeSystem::step_end_next`](crate::ode::OdeSystem)), as
-    /// the metric of the step's projection at `t`
-    /// ([`project_in_mass_metric`](Self::project_in_mass_metric)): DOP853's dense
-    /// stages, evaluated after it on the steps where the run interpolates, would
-    /// otherwise leave theirs, and the step would depend on where the rows are.
+    /// Holds $M$ of the last evaluation, at the state a step ends in (DOP853's last
+    /// stage, [`OdeSystem::step_end_next`](crate::ode::OdeSystem)), as the metric of the
+    /// step's projection at `t` ([`project_in_mass_metric`](Self::project_in_mass_metric)):
+    /// called before DOP853's dense stages, evaluated after it on the steps where the
+    /// run interpolates, which would otherwise leave theirs, so that the step would
+    /// depend on where the rows are. Other steps read the workspace's $M$, still that
+    /// evaluation's.
     pub(crate) fn hold_metric(&mut self, t: f64) {
         self.metric.clear();
         self.metric.extend_from_slice(&self.ws.mass_values);
@@ -1057,8 +1058,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         // evaluation of its own); the terms at the kept state when none is held, and
         // for an output row (the last evaluation there is the previous row's record,
         // and an interpolant off the manifold would land where that row was).
-        // The metric held at the step's last stage (`hold_metric`) when the state is
-        // that stage's.
+        // The metric held at the step's last stage (`hold_metric`, on steps with
+        // dense stages) when the state is that stage's.
         let held = held_t == Some(t) && !self.row;
         if self.terms == 0 || self.row {
             self.dynamics_terms(t)?;

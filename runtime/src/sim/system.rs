@@ -35,9 +35,12 @@ pub(crate) struct System<'a, M: Mechanism + ?Sized> {
     /// Recoverable failures since the last accepted step.
     retries: u32,
     /// Whether the next evaluation is at the state the step ends in
-    /// ([`OdeSystem::step_end_next`]): projection holds its $M$ for the step's
-    /// correction (`Point::hold_metric`).
+    /// ([`OdeSystem::step_end_next`]), and the time of the last evaluation when it was
+    /// that one: evaluations for the interpolant after it ([`OdeSystem::aside`]) would
+    /// replace its $M$, which projection holds for the step's correction first
+    /// (`Point::hold_metric`).
     step_end: bool,
+    step_end_t: Option<f64>,
     /// The failure of the last evaluation that failed.
     failure: Option<SimErrorKind>,
     /// Contacts, impacts and resting contacts (models with contacts only).
@@ -68,6 +71,7 @@ impl<'a, M: Mechanism + ?Sized> System<'a, M> {
             form: AnyForm::new(formulation, n, m, mh, tolerances),
             retries: 0,
             step_end: false,
+            step_end_t: None,
             failure: None,
             contacts: super::contacts::Contacts::new(info, tolerances.0)?,
         })
@@ -137,14 +141,13 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
             .and_then(|()| self.accelerations(t));
         match r {
             Ok(()) => {
-                if step_end && matches!(self.form, AnyForm::Projected(_)) {
-                    self.point.hold_metric(t);
-                }
+                self.step_end_t = step_end.then_some(t);
                 dy[..n].copy_from_slice(&self.point.qd);
                 dy[n..].copy_from_slice(self.point.qdd());
                 Ok(())
             }
             Err(e) => {
+                self.step_end_t = None;
                 let recoverable = self.form.recoverable(&e) && self.retries < MAX_RETRIES;
                 self.retries += u32::from(recoverable);
                 self.failure = Some(e);
@@ -166,8 +169,13 @@ impl<M: Mechanism + ?Sized> OdeSystem for System<'_, M> {
     }
 
     /// Evaluations for the interpolant only are corrected like an output row's
-    /// (`Point::row`): they teach the formulation nothing.
+    /// (`Point::row`): they teach the formulation nothing, and projection holds the $M$
+    /// of the step's last stage before they replace it (on the steps without them the
+    /// workspace still has it).
     fn aside(&mut self, on: bool) {
+        if let (true, Some(t), AnyForm::Projected(_)) = (on, self.step_end_t, &self.form) {
+            self.point.hold_metric(t);
+        }
         self.point.row = on;
     }
 }
