@@ -265,7 +265,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
             lu_h: SmallCholesky::new(mh),
             position_factor: false,
             row: false,
-            metric: Vec::new(),
+            metric: vec![0.0; info.mass_pattern.len()],
             metric_t: None,
             lu_v: SmallCholesky::new(m),
             gram_h: GramPlan::default(),
@@ -992,8 +992,7 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
     /// depend on where the rows are. Other steps read the workspace's $M$, still that
     /// evaluation's.
     pub(crate) fn hold_metric(&mut self, t: f64) {
-        self.metric.clear();
-        self.metric.extend_from_slice(&self.ws.mass_values);
+        self.metric.copy_from_slice(&self.ws.mass_values);
         self.metric_t = Some(t);
     }
 
