@@ -652,6 +652,23 @@ pub trait Mechanism {
         false
     }
 
+    /// The position map of partitioning's chart, $X = (N N^\mathsf{T})^{-1} N$ with
+    /// $N = C_q$ (row-major `m_h × n`), into `map` from the pattern values `cq`;
+    /// returns the pivot ratio of $N N^\mathsf{T}$ ($\min_k \rho_k / \max_k \rho_k$,
+    /// $\rho_k = d_k / G_{kk}$ the pivots of its $L D L^\mathsf{T}$ relative to their
+    /// diagonal entries), or `Some(0.0)` with `map` unfinished when a pivot is not
+    /// positive (dependent rows, a non-finite entry).
+    ///
+    /// The generator emits it for models with holonomic rows within the budget of its
+    /// solves: the Gram matrix from the products the pattern leaves, its factorization
+    /// with the fill computed at compile time, and the `n` solves over the
+    /// structurally non-zero entries, as straight-line code. The default returns `None`
+    /// (the runtime then factors the Gram matrix itself). Allocates nothing.
+    fn holonomic_normal_map(&self, cq: &[f64], map: &mut [f64]) -> Option<f64> {
+        let _ = (cq, map);
+        None
+    }
+
     /// The poses of the frames of [`Info::frames`]: 12 values per frame, the origin
     /// `(x, y, z)` and then the rotation matrix to the global frame, row-major. Planar
     /// frames have `z = 0` and turn about the z axis.

@@ -126,8 +126,10 @@ struct Maps {
     /// of most evaluations, and an anchor whose map no update reads costs no inverse.
     velocity_map_made: bool,
     /// The Cholesky factor of $N N^\mathsf{T}$ (of $G_a$ too when every row is
-    /// holonomic).
+    /// holonomic), when `factor_made`: the model's generated
+    /// [`Mechanism::holonomic_normal_map`] forms `position_map` without it.
     factor: SmallCholesky,
+    factor_made: bool,
     /// For each constraint row, its place in `rows` (`usize::MAX` when not projected).
     slot: Vec<usize>,
     /// The rows of the point's projections when anchored (the first `rows_h`
@@ -193,6 +195,7 @@ impl Maps {
             velocity_map_regular: false,
             velocity_map_made: false,
             factor: SmallCholesky::new(r),
+            factor_made: false,
             slot: vec![usize::MAX; m],
             rows: Vec::with_capacity(m),
             rows_h: 0,
@@ -258,13 +261,29 @@ impl Maps {
             self.velocity_map_made = true;
             self.velocity_map_regular = ratio.is_finite() && ratio > REFIT_RATIO;
         }
-        let factor = &mut self.factor;
-        factor.resize(r);
-        let ratio = gram_cholesky_planned(factor, &self.normals, plan_h);
-        for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
-            out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
-        }
-        factor.solve_rows(&mut self.position_map, n);
+        // Every holonomic row, in order: the model's generated map, where it has one.
+        let holonomic_in_order =
+            r == info.nh() && self.rows[..r].iter().enumerate().all(|(k, &i)| k == i);
+        let generated = holonomic_in_order
+            .then(|| {
+                p.mech
+                    .holonomic_normal_map(&p.ws.cq_values, &mut self.position_map)
+            })
+            .flatten();
+        self.factor_made = generated.is_none();
+        let ratio = match generated {
+            Some(ratio) => ratio,
+            None => {
+                let factor = &mut self.factor;
+                factor.resize(r);
+                let ratio = gram_cholesky_planned(factor, &self.normals, plan_h);
+                for (out, &i) in self.position_map.chunks_exact_mut(n.max(1)).zip(&self.rows) {
+                    out.copy_from_slice(&self.normals[i * n..(i + 1) * n]);
+                }
+                factor.solve_rows(&mut self.position_map, n);
+                ratio
+            }
+        };
         if m == r {
             // Made when first read (`inverse_gram`).
             self.velocity_map_made = false;
@@ -297,7 +316,14 @@ impl Maps {
             }
             None => {
                 if !self.velocity_map_made {
-                    self.factor.inverse_into(&mut self.velocity_map);
+                    if self.factor_made {
+                        self.factor.inverse_into(&mut self.velocity_map);
+                    } else {
+                        // From the generated map X = G⁻¹N: X Xᵀ = G⁻¹ N Nᵀ G⁻¹ = G⁻¹.
+                        let r = self.rows_h;
+                        let n = self.anchor.len();
+                        gram_of_rows(&self.position_map, r, n, &mut self.velocity_map);
+                    }
                     self.velocity_map_made = true;
                 }
                 symmetric_product(&self.velocity_map, mu, nu);
@@ -401,6 +427,18 @@ fn symmetric_product(a: &[f64], x: &[f64], y: &mut [f64]) {
     for (row, &xi) in a.chunks_exact(k.max(1)).zip(x) {
         for (yj, aij) in y.iter_mut().zip(row) {
             *yj += aij * xi;
+        }
+    }
+}
+
+/// $A A^\mathsf{T}$ of the row-major `a` (`r × n`) into `out` (`r × r`, row-major).
+fn gram_of_rows(a: &[f64], r: usize, n: usize, out: &mut [f64]) {
+    for i in 0..r {
+        for k in 0..=i {
+            let (ai, ak) = (&a[i * n..(i + 1) * n], &a[k * n..(k + 1) * n]);
+            let v: f64 = ai.iter().zip(ak).map(|(x, y)| x * y).sum();
+            out[i * r + k] = v;
+            out[k * r + i] = v;
         }
     }
 }

@@ -9,6 +9,7 @@ mod contacts;
 mod corrected;
 mod data;
 pub mod expr;
+mod normal_map;
 pub mod solve;
 
 use std::collections::HashSet;
@@ -493,6 +494,11 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
         (&d.cq, &d.gm),
     ));
     fns.extend(solve::holonomic_row_norms(d.c.len(), &d.cq));
+    fns.extend(normal_map::holonomic_normal_map(
+        model.coords.len(),
+        d.c.len(),
+        &d.cq,
+    ));
     if let Some((q0, qd0)) = &d.initial {
         let mut roots = q0.clone();
         roots.extend(qd0);
