@@ -144,8 +144,11 @@ struct Maps {
     /// dropped): the sparse $LDL^\mathsf{T}$ of $[I\ N^\mathsf{T}; N\ 0]$, whose
     /// solve with the right-hand side $[0; \mu]$ is $[P\mu; -(N N^\mathsf{T})^{-1}\mu]$:
     /// both maps applied in $O(\text{nnz})$, where forming them densely costs
-    /// $O(r^2 n)$ per anchor (`chain100`: 39 ms a step). `None` until first needed.
-    sparse: Option<Sparse>,
+    /// $O(r^2 n)$ per anchor (`chain100`: 39 ms a step). `None` until first needed;
+    /// boxed, because the staged maps and the anchor's are swapped at every accepted
+    /// step ([`Chart::anchor_staged`]) and the factor inline made that a copy of its
+    /// whole structure.
+    sparse: Option<Box<Sparse>>,
     /// Whether the maps of the current anchor are the sparse factor's.
     sparse_active: bool,
 }
@@ -237,7 +240,7 @@ impl Maps {
         if self.all_rows && m == r && r == info.nh() && r >= SPARSE_ROWS {
             if self.sparse.is_none() {
                 // Once per simulation (allocates).
-                self.sparse = Sparse::new(info);
+                self.sparse = Sparse::new(info).map(Box::new);
             }
             if let Some(sp) = self.sparse.as_mut() {
                 p.jacobian_values(t)?;
