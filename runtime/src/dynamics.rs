@@ -154,7 +154,7 @@ pub struct AccelerationStats {
 pub enum DynamicsError {
     /// The augmented matrix is singular although $J$ has full rank (or the reduced one
     /// is singular): $M$ is not positive definite on $\ker J$.
-    #[error("augmented system singular at t = {t:?} with `J` of rank {rank} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", free_list(coordinates))]
+    #[error("augmented system singular at t = {t:?} with `J` of rank {rank} (pivot ratio {ratio:e}): {}", singular_cause(*jacobian_ratio, nearly_dependent, coordinates))]
     Singular {
         /// Time.
         t: f64,
@@ -166,9 +166,18 @@ pub enum DynamicsError {
         /// unknowns complete pivoting finds no pivot for, a massless coordinate for
         /// instance).
         coordinates: Vec<&'static str>,
+        /// Smallest / largest pivot of the rows of $J$ kept (complete pivoting of the
+        /// row-equilibrated $J$): the pivots of the augmented matrix's constraint block
+        /// are of the order of their squares, so rows within [`NEARLY_DEPENDENT`] of
+        /// dependence make it singular however regular $M$ is.
+        jacobian_ratio: f64,
+        /// The kept constraints whose rows are within [`NEARLY_DEPENDENT`] of
+        /// dependence on the others (the rows complete pivoting reaches last): empty when
+        /// $J$ is well conditioned and the mass matrix is what is singular.
+        nearly_dependent: Vec<&'static str>,
     },
     /// Redundant constraints whose acceleration terms contradict the others.
-    #[error("redundant constraints {constraints:?} are inconsistent at t = {t:?}: acceleration residual {residual:e}{}", vanishing_note(vanishing))]
+    #[error("constraints {constraints:?} depend on the others at t = {t:?} and their acceleration equations contradict them (residual {residual:e}): redundant constraints that are inconsistent, or a singular configuration of independent ones (a lock of the mechanism, or a state carried there by the integration's drift){}", vanishing_note(vanishing))]
     InconsistentRedundant {
         /// Time.
         t: f64,
@@ -713,7 +722,13 @@ impl Dynamics {
         // of J M⁻¹ Jᵀ, the squares of J's: rows of J whose pivot ratio is below the
         // square root of the tolerance are what made the augmented matrix fail it (near
         // a change point, where loop closures become dependent).
-        let rank = elim.phase(0, m, m, self.params.rank_tolerance.sqrt()).rank;
+        let phase = elim.phase(0, m, m, self.params.rank_tolerance.sqrt());
+        let rank = phase.rank;
+        let jacobian_ratio = if rank == 0 {
+            0.0
+        } else {
+            phase.min_pivot / phase.scale
+        };
         if rank == m {
             let mut lu = DenseLu::new(n + m, 1);
             fill_dense(&mut lu, info, ws, None);
@@ -723,6 +738,8 @@ impl Dynamics {
                 rank,
                 ratio: lu.factor().ratio(),
                 coordinates,
+                jacobian_ratio,
+                nearly_dependent: nearly_dependent(ws, info, &elim.rows[..rank]),
             });
         }
         let mut split = Split::new(
@@ -757,6 +774,8 @@ impl Dynamics {
                     rank,
                     ratio,
                     coordinates: free_coordinates(&mut lu, info, rank_tol),
+                    jacobian_ratio,
+                    nearly_dependent: nearly_dependent(ws, info, &split.rows_r),
                 })
             }
             // (A fresh split is not checked for independent rows.)
@@ -1013,6 +1032,62 @@ fn free_coordinates(lu: &mut DenseLu, info: &Info, tol: f64) -> Vec<&'static str
 }
 
 /// "coordinates involved: [..]", or why none are named.
+/// The pivot ratio of $J$'s kept rows below which [`DynamicsError::Singular`] names
+/// them as nearly dependent: the augmented matrix's constraint pivots are of the order
+/// of the squares of $J$'s, so at $10^{-3}$ they are $10^{-6}$ of its diagonal, and the
+/// rank tolerance ($10^{-10}$) is met by a mass matrix conditioned to $10^{-4}$.
+pub const NEARLY_DEPENDENT: f64 = 1e-3;
+
+/// The constraints among `rows` (the rows of $J$ kept) that complete pivoting of the
+/// row-equilibrated rows finds within [`NEARLY_DEPENDENT`] of dependence (the rows it
+/// reaches after the last pivot above that ratio). Allocates (an error path).
+fn nearly_dependent(ws: &Workspace, info: &Info, rows: &[usize]) -> Vec<&'static str> {
+    let n = info.nq();
+    let mh = info.nh();
+    let mut kept = Vec::with_capacity(rows.len() * n);
+    for &r in rows {
+        kept.extend_from_slice(&ws.jacobian[r * n..(r + 1) * n]);
+    }
+    let mut elim = Elimination::new(rows.len(), n);
+    elim.load(&kept);
+    let well = elim.phase(0, rows.len(), rows.len(), NEARLY_DEPENDENT).rank;
+    elim.rows[well..]
+        .iter()
+        .map(|&k| {
+            let r = rows[k];
+            if r < mh {
+                info.holonomic[r].name
+            } else {
+                info.nonholonomic[r - mh].name
+            }
+        })
+        .collect()
+}
+
+/// The cause clause of [`DynamicsError::Singular`]: the nearly dependent constraints
+/// when there are any, the mass matrix otherwise.
+fn singular_cause(jacobian_ratio: f64, nearly: &[&str], coordinates: &[&str]) -> String {
+    if nearly.is_empty() {
+        format!(
+            "the mass matrix is singular on the constraint tangent space; {}",
+            free_list(coordinates)
+        )
+    } else {
+        near_singular_clause(jacobian_ratio, nearly)
+    }
+}
+
+/// What a singular augmented matrix with the nearly dependent constraints `nearly`
+/// (non-empty) means.
+pub(crate) fn near_singular_clause(jacobian_ratio: f64, nearly: &[&str]) -> String {
+    format!(
+        "the constraints {nearly:?} are nearly dependent on the others there (pivot ratio \
+         of `J` {jacobian_ratio:e}): a near-singular configuration, where the constraint \
+         forces needed grow without bound (a change point or a lock of the mechanism, or a \
+         state carried there by the integration's drift)"
+    )
+}
+
 fn free_list(coordinates: &[&str]) -> String {
     if coordinates.is_empty() {
         "no single coordinate is undetermined (the singular direction mixes accelerations and multipliers)".to_owned()

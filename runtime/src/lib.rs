@@ -72,7 +72,7 @@ pub use assembly::{
 pub use drawing::{DrawPoint, Drawing, Shape, ShapeKind};
 pub use dynamics::{
     AccelerationStats, Dynamics, DynamicsError, DynamicsParams, LinearSolver, SolverPath,
-    DEFAULT_CROSSOVER,
+    DEFAULT_CROSSOVER, NEARLY_DEPENDENT,
 };
 pub use error::Error;
 pub use ext::{DerivativeCheck, MechanismExt, Residuals};

@@ -167,7 +167,11 @@ pub enum SimErrorKind {
     /// The augmented matrix of (E31) is singular while $J$ has full rank: the mass
     /// matrix is singular on the tangent space of the constraints (a massless
     /// coordinate that no constraint determines, for instance).
-    #[error("singular augmented matrix at t = {t:?} (pivot ratio {ratio:e}): the mass matrix is singular on the constraint tangent space; {}", involved("coordinates", coordinates, "the singular direction mixes accelerations and multipliers"))]
+    ///
+    /// Or its constraint block is what fails: the kept rows of $J$ nearly dependent
+    /// (`nearly_dependent` names them; see [`crate::DynamicsError::Singular`]), a
+    /// near-singular configuration rather than a singular mass matrix.
+    #[error("singular augmented matrix at t = {t:?} (pivot ratio {ratio:e}): {}", singular_mass_cause(*jacobian_ratio, nearly_dependent, coordinates))]
     SingularMass {
         /// Time.
         t: f64,
@@ -175,6 +179,11 @@ pub enum SimErrorKind {
         ratio: f64,
         /// The coordinates whose accelerations are undetermined.
         coordinates: Vec<&'static str>,
+        /// Smallest / largest pivot of the kept rows of $J$.
+        jacobian_ratio: f64,
+        /// The constraints within [`crate::NEARLY_DEPENDENT`] of dependence on the
+        /// others (empty: the mass matrix is what is singular).
+        nearly_dependent: Vec<&'static str>,
     },
     /// The step size fell below what the precision of `t` resolves.
     #[error("step size {h:e} too small at t = {t:?}")]
@@ -286,11 +295,15 @@ impl SimErrorKind {
                 t,
                 ratio,
                 coordinates,
+                jacobian_ratio,
+                nearly_dependent,
                 ..
             }) => Self::SingularMass {
                 t,
                 ratio,
                 coordinates,
+                jacobian_ratio,
+                nearly_dependent,
             },
             Error::Eval(e)
             | Error::Kinematics(KinematicsError::Eval(e))
@@ -338,6 +351,22 @@ impl SimErrorKind {
 }
 
 /// `"{what} involved: [..]"`, or why none can be named.
+/// The cause clause of [`SimErrorKind::SingularMass`].
+fn singular_mass_cause(jacobian_ratio: f64, nearly: &[&str], coordinates: &[&str]) -> String {
+    if nearly.is_empty() {
+        format!(
+            "the mass matrix is singular on the constraint tangent space; {}",
+            involved(
+                "coordinates",
+                coordinates,
+                "the singular direction mixes accelerations and multipliers"
+            )
+        )
+    } else {
+        crate::dynamics::near_singular_clause(jacobian_ratio, nearly)
+    }
+}
+
 fn involved(what: &str, names: &[&str], otherwise: &str) -> String {
     if names.is_empty() {
         format!("no {what} identified: {otherwise}")

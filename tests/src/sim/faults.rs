@@ -413,3 +413,33 @@ fn a_non_finite_jacobian_with_finite_constraints_is_named() {
         assert_named_non_finite(sim, form, Quantity::HolonomicJacobian);
     }
 }
+
+/// A massless bob (`m = 0`): the kinetic energy vanishes, so the mass matrix is
+/// singular along the rod's tangent while the rod's gradient $(2x, 2y)$ is regular.
+/// Every formulation's first solve fails with the mass matrix named as the cause and
+/// no constraint named as nearly dependent (the Jacobian's one row has pivot ratio 1).
+#[test]
+fn a_massless_bob_blames_the_mass_matrix() {
+    let mut model = pendulum::Model::default();
+    let m = model.info().parameter_index("m").unwrap();
+    model.set_parameter(m, 0.0);
+    for formulation in Formulation::ALL {
+        let err = Simulation::new(&model)
+            .formulation(formulation)
+            .run(1.0)
+            .unwrap_err();
+        let message = err.to_string();
+        match &err.kind {
+            SimErrorKind::SingularMass {
+                jacobian_ratio,
+                nearly_dependent,
+                ..
+            } => {
+                assert!(nearly_dependent.is_empty(), "{message}");
+                assert!(*jacobian_ratio >= pfaff::NEARLY_DEPENDENT, "{message}");
+                assert!(message.contains("mass matrix is singular"), "{message}");
+            }
+            other => panic!("{}: {other}", formulation.name()),
+        }
+    }
+}
