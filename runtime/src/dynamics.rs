@@ -153,7 +153,9 @@ pub struct AccelerationStats {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DynamicsError {
     /// The augmented matrix is singular although $J$ has full rank (or the reduced one
-    /// is singular): $M$ is not positive definite on $\ker J$.
+    /// is singular): $M$ is not positive definite on $\ker J$, or the kept rows of $J$
+    /// are nearly dependent (`nearly_dependent` names them: a near-singular
+    /// configuration).
     #[error("augmented system singular at t = {t:?} with `J` of rank {rank} (pivot ratio {ratio:e}): {}", singular_cause(*jacobian_ratio, nearly_dependent, coordinates))]
     Singular {
         /// Time.
@@ -1031,11 +1033,11 @@ fn free_coordinates(lu: &mut DenseLu, info: &Info, tol: f64) -> Vec<&'static str
     free.iter().map(|&j| info.coordinates[j].name).collect()
 }
 
-/// "coordinates involved: [..]", or why none are named.
 /// The pivot ratio of $J$'s kept rows below which [`DynamicsError::Singular`] names
-/// them as nearly dependent: the augmented matrix's constraint pivots are of the order
-/// of the squares of $J$'s, so at $10^{-3}$ they are $10^{-6}$ of its diagonal, and the
-/// rank tolerance ($10^{-10}$) is met by a mass matrix conditioned to $10^{-4}$.
+/// them as nearly dependent. The augmented matrix's constraint pivots are of the order
+/// of the squares of $J$'s: with $J$'s above $10^{-3}$ they are above $10^{-6}$, so a
+/// failure of the rank tolerance ($10^{-10}$) needs a mass matrix conditioned worse
+/// than $10^{-4}$ on the tangent space, and is named as the mass matrix's.
 pub const NEARLY_DEPENDENT: f64 = 1e-3;
 
 /// The constraints among `rows` (the rows of $J$ kept) that complete pivoting of the
@@ -1088,6 +1090,7 @@ pub(crate) fn near_singular_clause(jacobian_ratio: f64, nearly: &[&str]) -> Stri
     )
 }
 
+/// "coordinates involved: [..]", or why none are named.
 fn free_list(coordinates: &[&str]) -> String {
     if coordinates.is_empty() {
         "no single coordinate is undetermined (the singular direction mixes accelerations and multipliers)".to_owned()

@@ -1146,6 +1146,34 @@ mod tests {
 
     const ROW: Symbol = Symbol { name: "c", doc: "" };
 
+    /// $X X^\mathsf{T}$ of the position map $X = (N N^\mathsf{T})^{-1} N$ is
+    /// $(N N^\mathsf{T})^{-1}$ (what the velocity chord reads when the model's generated
+    /// map made $X$): $G (X X^\mathsf{T}) = I$ to round-off for a seeded `3 × 5` $N$,
+    /// with $X$ from the Cholesky factor's solves.
+    #[test]
+    fn the_map_times_its_transpose_is_the_inverse_gram() {
+        #[allow(clippy::cast_precision_loss)]
+        let value = |k: usize| (0.61 * (k * k + 3) as f64).sin();
+        let (r, n) = (3, 5);
+        let normals: Vec<f64> = (0..r * n).map(value).collect();
+        let mut gram = vec![0.0; r * r];
+        gram_of_rows(&normals, r, n, &mut gram);
+        let mut ch = SmallCholesky::new(r);
+        ch.matrix_mut().copy_from_slice(&gram);
+        assert!(ch.factor().ratio() > 1e-6);
+        let mut map = normals.clone();
+        ch.solve_rows(&mut map, n);
+        let mut inverse = vec![0.0; r * r];
+        gram_of_rows(&map, r, n, &mut inverse);
+        for i in 0..r {
+            for k in 0..r {
+                let gi: f64 = (0..r).map(|j| gram[i * r + j] * inverse[j * r + k]).sum();
+                let want = if i == k { 1.0 } else { 0.0 };
+                assert!((gi - want).abs() < 1e-12, "(G X Xᵀ)[{i}, {k}] = {gi}");
+            }
+        }
+    }
+
     /// The unrolled position update is the general loop's, bit for bit: the same
     /// changes, largest change and weighted change, for every size it serves and the
     /// sizes around them, with values whose order of addition shows in the last bits,

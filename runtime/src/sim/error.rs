@@ -350,7 +350,6 @@ impl SimErrorKind {
     }
 }
 
-/// `"{what} involved: [..]"`, or why none can be named.
 /// The cause clause of [`SimErrorKind::SingularMass`].
 fn singular_mass_cause(jacobian_ratio: f64, nearly: &[&str], coordinates: &[&str]) -> String {
     if nearly.is_empty() {
@@ -367,6 +366,7 @@ fn singular_mass_cause(jacobian_ratio: f64, nearly: &[&str], coordinates: &[&str
     }
 }
 
+/// `"{what} involved: [..]"`, or why none can be named.
 fn involved(what: &str, names: &[&str], otherwise: &str) -> String {
     if names.is_empty() {
         format!("no {what} identified: {otherwise}")
