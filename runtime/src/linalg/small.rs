@@ -532,9 +532,9 @@ fn solve_rows_fixed<const N: usize>(
 /// dot products of rows are each a chain of `n` dependent additions. The sums run over
 /// the columns in the same order either way, so the two give the same bits.
 ///
-/// The dense reference of [`gram_cholesky_planned`], which every Gram matrix of the
-/// runtime uses (its tests compare the two bit for bit).
-#[cfg(test)]
+/// The dense reference of [`gram_cholesky_planned`], which the runtime's Gram matrices
+/// use (its tests compare the two bit for bit); the chart uses this one where no plan
+/// is at hand (the anchor's $G_a^{-1}$ made late, after the model's generated map).
 pub(crate) fn gram_cholesky(ch: &mut SmallCholesky, a: &[f64], rows: &[usize], n: usize) -> f64 {
     let r = rows.len();
     let g = ch.matrix_mut();
@@ -614,7 +614,6 @@ pub(crate) fn gram_cholesky_planned(ch: &mut SmallCholesky, a: &[f64], plan: &Gr
 }
 
 /// The lower triangle of [`gram_cholesky`]'s matrix for `R` rows.
-#[cfg(test)]
 // Index loops over constant bounds are what the compiler unrolls.
 #[allow(clippy::needless_range_loop)]
 fn gram_fixed<const R: usize>(g: &mut [f64], a: &[f64], rows: &[usize], n: usize) {

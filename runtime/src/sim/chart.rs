@@ -48,7 +48,7 @@
 
 use super::point::{Point, REFIT_RATIO};
 use crate::linalg::inf_norm;
-use crate::linalg::small::{gram_cholesky_planned, SmallCholesky};
+use crate::linalg::small::{gram_cholesky, gram_cholesky_planned, SmallCholesky};
 use crate::linalg::sparse::SparseLdlt;
 use crate::scale;
 use crate::workspace::EvalError;
@@ -127,7 +127,8 @@ struct Maps {
     velocity_map_made: bool,
     /// The Cholesky factor of $N N^\mathsf{T}$ (of $G_a$ too when every row is
     /// holonomic), when `factor_made`: the model's generated
-    /// [`Mechanism::holonomic_normal_map`] forms `position_map` without it.
+    /// [`Mechanism::holonomic_normal_map`] forms `position_map` without it, and the
+    /// factor is then made only if a velocity chord update reads $G_a^{-1}$.
     factor: SmallCholesky,
     factor_made: bool,
     /// For each constraint row, its place in `rows` (`usize::MAX` when not projected).
@@ -319,14 +320,15 @@ impl Maps {
             }
             None => {
                 if !self.velocity_map_made {
-                    if self.factor_made {
-                        self.factor.inverse_into(&mut self.velocity_map);
-                    } else {
-                        // From the generated map X = G⁻¹N: X Xᵀ = G⁻¹ N Nᵀ G⁻¹ = G⁻¹.
-                        let r = self.rows_h;
-                        let n = self.anchor.len();
-                        gram_of_rows(&self.position_map, r, n, &mut self.velocity_map);
+                    if !self.factor_made {
+                        // The model's generated map served the anchor: the factor now,
+                        // from the anchor's normals (the planned product's bits).
+                        let (r, n) = (self.rows_h, self.anchor.len());
+                        self.factor.resize(r);
+                        gram_cholesky(&mut self.factor, &self.normals, &self.rows[..r], n);
+                        self.factor_made = true;
                     }
+                    self.factor.inverse_into(&mut self.velocity_map);
                     self.velocity_map_made = true;
                 }
                 symmetric_product(&self.velocity_map, mu, nu);
@@ -430,18 +432,6 @@ fn symmetric_product(a: &[f64], x: &[f64], y: &mut [f64]) {
     for (row, &xi) in a.chunks_exact(k.max(1)).zip(x) {
         for (yj, aij) in y.iter_mut().zip(row) {
             *yj += aij * xi;
-        }
-    }
-}
-
-/// $A A^\mathsf{T}$ of the row-major `a` (`r × n`) into `out` (`r × r`, row-major).
-fn gram_of_rows(a: &[f64], r: usize, n: usize, out: &mut [f64]) {
-    for i in 0..r {
-        for k in 0..=i {
-            let (ai, ak) = (&a[i * n..(i + 1) * n], &a[k * n..(k + 1) * n]);
-            let v: f64 = ai.iter().zip(ak).map(|(x, y)| x * y).sum();
-            out[i * r + k] = v;
-            out[k * r + i] = v;
         }
     }
 }
@@ -1145,34 +1135,6 @@ mod tests {
     use crate::mechanism::Symbol;
 
     const ROW: Symbol = Symbol { name: "c", doc: "" };
-
-    /// $X X^\mathsf{T}$ of the position map $X = (N N^\mathsf{T})^{-1} N$ is
-    /// $(N N^\mathsf{T})^{-1}$ (what the velocity chord reads when the model's generated
-    /// map made $X$): $G (X X^\mathsf{T}) = I$ to round-off for a seeded `3 × 5` $N$,
-    /// with $X$ from the Cholesky factor's solves.
-    #[test]
-    fn the_map_times_its_transpose_is_the_inverse_gram() {
-        #[allow(clippy::cast_precision_loss)]
-        let value = |k: usize| (0.61 * (k * k + 3) as f64).sin();
-        let (r, n) = (3, 5);
-        let normals: Vec<f64> = (0..r * n).map(value).collect();
-        let mut gram = vec![0.0; r * r];
-        gram_of_rows(&normals, r, n, &mut gram);
-        let mut ch = SmallCholesky::new(r);
-        ch.matrix_mut().copy_from_slice(&gram);
-        assert!(ch.factor().ratio() > 1e-6);
-        let mut map = normals.clone();
-        ch.solve_rows(&mut map, n);
-        let mut inverse = vec![0.0; r * r];
-        gram_of_rows(&map, r, n, &mut inverse);
-        for i in 0..r {
-            for k in 0..r {
-                let gi: f64 = (0..r).map(|j| gram[i * r + j] * inverse[j * r + k]).sum();
-                let want = if i == k { 1.0 } else { 0.0 };
-                assert!((gi - want).abs() < 1e-12, "(G X Xᵀ)[{i}, {k}] = {gi}");
-            }
-        }
-    }
 
     /// The unrolled position update is the general loop's, bit for bit: the same
     /// changes, largest change and weighted change, for every size it serves and the
