@@ -350,6 +350,8 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
             "rhs_evals": s.rhs_evals,
             "newton_iterations": s.newton_iterations,
             "factorizations": s.factorizations,
+            "output_newton_iterations": s.output_newton_iterations,
+            "output_factorizations": s.output_factorizations,
             "repartitions": s.repartitions,
             "jacobians": s.jacobians,
             "stage_factorizations": s.stage_factorizations,
@@ -433,6 +435,14 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
         "work         {} steps ({} rejected), {} rhs evaluations, {} Newton iterations, {} factorizations, {} re-partitions",
         s.steps, s.rejected, s.rhs_evals, s.newton_iterations, s.factorizations, s.repartitions
     );
+    if s.output_factorizations > 0 {
+        let rows = run.trajectory.len();
+        let _ = writeln!(
+            w,
+            "output rows  {rows} rows, {} Newton iterations, {} factorizations (their corrections onto the constraints and multipliers, apart from the integration's)",
+            s.output_newton_iterations, s.output_factorizations
+        );
+    }
     if s.jacobians > 0 {
         let _ = writeln!(
             w,

@@ -90,6 +90,9 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     y: &'a mut [f64],
     overridden: Vec<crate::OverriddenVelocity>,
     repartition_times: Vec<f64>,
+    /// Newton iterations and factorizations spent on output rows (see
+    /// [`output_row`](Self::output_row)).
+    output_work: (u64, u64),
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -114,6 +117,25 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         self.traj
             .push(t, &p.q, &p.qd, p.lambda(), v.0, v.1.max(v.2), energy);
         Ok(())
+    }
+
+    /// Records the output row at `t` from the step's dense output (`y` scratch): the
+    /// interpolated state corrected onto the constraints as the formulation keeps
+    /// states, and its accelerations and multipliers. Its Newton iterations and
+    /// factorizations are counted apart from the integration's, which they do not serve
+    /// ([`Stats::output_newton_iterations`]): a run with many rows would otherwise
+    /// report the corrections of its rows as work per evaluation.
+    fn output_row(&mut self, stepper: &Stepper, t: f64, y: &mut [f64]) -> Result<(), SimErrorKind> {
+        stepper.interpolate(t, y).map_err(SimErrorKind::from_ode)?;
+        let before = (
+            self.sys.point.newton_iterations,
+            self.sys.point.factorizations,
+        );
+        let kept = self.sys.keep_row(t, y).and_then(|_| self.record(t));
+        let p = &self.sys.point;
+        self.output_work.0 += p.newton_iterations - before.0;
+        self.output_work.1 += p.factorizations - before.1;
+        kept
     }
 
     /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
@@ -185,9 +207,12 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     /// used after it: a copy of the trajectory was a copy and seven allocations per
     /// run).
     fn run(&mut self, stepper: Option<&Stepper>) -> Run {
+        let (output_newton, output_factorizations) = self.output_work;
         let mut stats = Stats {
-            newton_iterations: self.sys.point.newton_iterations,
-            factorizations: self.sys.point.factorizations,
+            newton_iterations: self.sys.point.newton_iterations - output_newton,
+            factorizations: self.sys.point.factorizations - output_factorizations,
+            output_newton_iterations: output_newton,
+            output_factorizations,
             repartitions: self.sys.point.kin.repartitions() as u64,
             wall_time: self.started.elapsed(),
             ..Stats::default()
@@ -375,6 +400,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         y: &mut y,
         overridden,
         repartition_times: Vec::new(),
+        output_work: (0, 0),
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
@@ -520,9 +546,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             let te = found.t();
             while next_out < times.len() && times[next_out] < te {
                 let to = times[next_out];
-                check!(stepper.interpolate(to, &mut yout).map_err(ode));
-                check!(rec.sys.keep_row(to, &yout));
-                check!(rec.record(to));
+                check!(rec.output_row(&stepper, to, &mut yout));
                 next_out += 1;
             }
             if let (true, Found::Closing { c: k, t: te }) = (refine_events, found) {
@@ -546,9 +570,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 // Rows the correction moved before the event.
                 while next_out < times.len() && times[next_out] < found.t() {
                     let to = times[next_out];
-                    check!(stepper.interpolate(to, &mut yout).map_err(ode));
-                    check!(rec.sys.keep_row(to, &yout));
-                    check!(rec.record(to));
+                    check!(rec.output_row(&stepper, to, &mut yout));
                     next_out += 1;
                 }
             }
@@ -646,9 +668,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         }
         while next_out < times.len() && times[next_out] <= t {
             let to = times[next_out];
-            check!(stepper.interpolate(to, &mut yout).map_err(ode));
-            check!(rec.sys.keep_row(to, &yout));
-            check!(rec.record(to));
+            check!(rec.output_row(&stepper, to, &mut yout));
             next_out += 1;
         }
         if steps_back {

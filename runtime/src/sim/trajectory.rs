@@ -160,12 +160,21 @@ pub struct Stats {
     /// Evaluations of the state-space right-hand side (each one is a full K1 + K2 +
     /// augmented solve for partitioning, one augmented solve otherwise).
     pub rhs_evals: u64,
-    /// Newton updates: K1 in the right-hand side, at outputs and at accepted steps, and
-    /// the position projection.
+    /// Newton updates of the integration: the position corrections of the right-hand
+    /// side and of accepted steps, and the position projection (output rows apart, in
+    /// [`output_newton_iterations`](Self::output_newton_iterations)).
     pub newton_iterations: u64,
-    /// Matrix factorizations: one per Newton update, per velocity solve (K2 or
-    /// projection) and per augmented solve (right-hand side and multipliers at outputs).
+    /// Matrix factorizations of the integration: one per Newton update, per velocity
+    /// solve and per augmented solve of a right-hand side (output rows apart, in
+    /// [`output_factorizations`](Self::output_factorizations)).
     pub factorizations: u64,
+    /// Newton updates spent on output rows: the interpolated states of requested output
+    /// times corrected onto the constraints. They serve the output, not the
+    /// integration, which never continues from them.
+    pub output_newton_iterations: u64,
+    /// Factorizations spent on output rows: their corrections, and the augmented solves
+    /// of their accelerations and multipliers.
+    pub output_factorizations: u64,
     /// Re-partitions (monitor or recovery from a failed Newton iteration).
     pub repartitions: u64,
     /// Jacobians of the right-hand side formed by an implicit integrator

@@ -120,6 +120,42 @@ fn andrews_takes_at_most_two_newton_updates_per_evaluation() {
     }
 }
 
+/// Output rows are corrected onto the constraints and their multipliers solved, work
+/// that serves the output and not the integration: `Stats` counts it apart. The same
+/// run of `andrews` (the command's default: partitioning + Adams, rtol 1e-6) with 500
+/// rows and with none takes the same steps and evaluations and the same integration
+/// work, within the final state's row (recorded as an output row in the first run and
+/// as the last accepted state in the second); the rows' work appears only in the first.
+#[test]
+fn the_work_of_output_rows_is_counted_apart() {
+    let model = andrews::Model::default();
+    let run = |every: Option<f64>| {
+        let sim = Simulation::new(&model)
+            .formulation(Formulation::Partitioning)
+            .integrator(Method::Adams)
+            .tolerances(1e-6, 1e-8);
+        match every {
+            Some(dt) => sim.output_every(dt),
+            None => sim.output_times(&[]),
+        }
+        .run(0.03)
+        .unwrap()
+        .stats
+    };
+    let (rows, none) = (run(Some(0.03 / 500.0)), run(None));
+    eprintln!("with rows {rows:?}\nwithout   {none:?}");
+    assert_eq!((rows.steps, rows.rhs_evals), (none.steps, none.rhs_evals));
+    assert!(rows.newton_iterations.abs_diff(none.newton_iterations) <= 2);
+    assert!(rows.factorizations.abs_diff(none.factorizations) <= 3);
+    // At least the multipliers of each of the 500 rows.
+    assert!(rows.output_factorizations >= 500, "{rows:?}");
+    assert!(rows.output_newton_iterations > 0, "{rows:?}");
+    assert_eq!(
+        (none.output_newton_iterations, none.output_factorizations),
+        (0, 0)
+    );
+}
+
 /// The pendulum to t = 1000 s (422 periods) at rtol = atol = 1e-12 with partitioning,
 /// with Adams (the command's default) and DOP853 (the library's default): the final
 /// position within 1e-7 of the closed form (benchmark-models.md; the exact solution at
