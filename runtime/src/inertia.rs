@@ -67,12 +67,31 @@ pub fn negative_direction<M: Mechanism + ?Sized>(
     q: &[f64],
     qd: &[f64],
 ) -> Result<Option<NegativeDirection>, EvalError> {
+    let n = mech.info().nq();
+    if n == 0 || n > LIMIT {
+        return Ok(None);
+    }
+    negative_direction_in(mech, &mut Workspace::new(mech.info())?, t, q, qd)
+}
+
+/// [`negative_direction`] with the caller's workspace `ws` (the model's), whose mass
+/// matrix, forces and Jacobian it overwrites: a simulation checks its start with the
+/// workspace it runs in instead of allocating one.
+///
+/// # Errors
+/// As [`negative_direction`].
+pub(crate) fn negative_direction_in<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<Option<NegativeDirection>, EvalError> {
     let info = mech.info();
     let n = info.nq();
     if n == 0 || n > LIMIT {
         return Ok(None);
     }
-    let mut ws = Workspace::new(info)?;
     ws.eval_mass_and_forces(mech, t, q, qd)?;
     ws.eval_jacobian(mech, t, q)?;
     Ok(factor(n, info.mass_pattern, &ws.mass_values, ws.jacobian()))

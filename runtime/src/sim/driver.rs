@@ -350,7 +350,10 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     };
     // A mass matrix with a negative direction has no physical motion, and nothing
     // later stops it (the general solve is regular): checked once, here.
-    match crate::inertia::negative_direction(mech, t0, &q, &qd) {
+    let negative = crate::inertia::negative_direction_in(mech, &mut sys.point.ws, t0, &q, &qd);
+    // The terms it evaluated are not the point's (its state is set below).
+    sys.point.invalidate();
+    match negative {
         Ok(None) => {}
         Ok(Some(found)) => {
             return Err(empty(SimErrorKind::NegativeMass {
