@@ -10,6 +10,17 @@
 //! impossible); Newton K1 on $\beta$; the velocity solve K2 with the non-prescribed
 //! independent velocities taken from the guess.
 //!
+//! **A singular guess.** Holding a coordinate can leave the others undetermined at the
+//! guess itself: a pendulum in Cartesian coordinates with `x` held at 0.6 and `y` at
+//! its guess 0, where $\partial C/\partial y = 2y$ vanishes. When Algorithm P cannot
+//! keep a prescribed coordinate independent, the free coordinates whose column of
+//! $C_q$ vanishes at the guess are moved by [`GUESS_NUDGE`] (relative) and the
+//! partition is tried once more; those it leaves independent go back to their guesses,
+//! Newton solves for the others from the moved values, and
+//! [`AssemblyReport::moved_guesses`] lists them (the branch reached, here $y = +0.8$,
+//! follows the direction of the move). If the partition fails again, the first error
+//! stands.
+//!
 //! **A full state.** When every coordinate is prescribed there is nothing to solve: the
 //! values are checked against the constraints instead, each row $i$ within
 //! [`CONSISTENCY_TOLERANCE`] of its scale,
@@ -79,7 +90,7 @@ pub struct Prescription<'a> {
 }
 
 /// Outcome of an assembly.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct AssemblyReport {
     /// The position solve.
     pub newton: NewtonStats,
@@ -89,6 +100,36 @@ pub struct AssemblyReport {
     pub velocity_correction: f64,
     /// $\lVert [C_q\dot q + C_t;\ G\dot q + g]\rVert_\infty$ at the result.
     pub velocity_residual: f64,
+    /// Guesses of free coordinates moved off a configuration where the constraints do
+    /// not determine them, so that the prescribed coordinates could be held (module
+    /// docs, "A singular guess"); empty when the guess served as given.
+    pub moved_guesses: Vec<MovedGuess>,
+}
+
+/// The relative size of the move of a singular guess: a coordinate's guess $g$ moves
+/// to $g + 10^{-3}\max(1, |g|)$ (module docs, "A singular guess").
+pub const GUESS_NUDGE: f64 = 1e-3;
+
+/// A guess moved by the assembly (see [`AssemblyReport::moved_guesses`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovedGuess {
+    /// The coordinate.
+    pub coordinate: &'static str,
+    /// Its guess.
+    pub guess: f64,
+    /// Where the guess was moved before the Newton iteration.
+    pub moved_to: f64,
+}
+
+impl std::fmt::Display for MovedGuess {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the guess of `{}` was moved from {} to {}: the constraints do not determine it there, \
+             and the prescribed coordinates needed it to be solved for",
+            self.coordinate, self.guess, self.moved_to
+        )
+    }
 }
 
 /// A declared initial velocity that the constraints determine from the others (see
@@ -284,9 +325,31 @@ impl Kinematics {
             coordinates: &pos_idx,
             velocities: &vel_idx,
         };
+        let mut moved_guesses = Vec::new();
         if let Err(e) = self.repartition_with(mech, ws, t, q, prefs) {
-            self.partition = previous;
-            return Err(e.into());
+            let retried = matches!(e, PartitionError::PrescribedCoordinate { .. })
+                && move_singular_guesses(mech, ws, t, q, &pos_idx, &mut moved_guesses)?
+                && self.repartition_with(mech, ws, t, q, prefs).is_ok();
+            if !retried {
+                q.copy_from_slice(&q0);
+                self.partition = previous;
+                return Err(e.into());
+            }
+            // Only the guesses Newton solves for need the move: the others (left
+            // independent by the new partition) go back to their values.
+            let dependent = &self
+                .partition
+                .as_ref()
+                .expect("partitioned above")
+                .dependent;
+            moved_guesses.retain(|m| {
+                let j = info.coordinate_index(m.coordinate).expect("a coordinate");
+                let solved = dependent.contains(&j);
+                if !solved {
+                    q[j] = m.guess;
+                }
+                solved
+            });
         }
         let newton = if all_q {
             ws.eval_constraints(mech, t, q)?;
@@ -314,8 +377,45 @@ impl Kinematics {
             position_correction: diff(q, &q0),
             velocity_correction: diff(qd, &qd0),
             velocity_residual,
+            moved_guesses,
         })
     }
+}
+
+/// Moves the guesses of the free coordinates (not in `held`, in some holonomic
+/// constraint) whose column of $C_q$ vanishes at `q` by [`GUESS_NUDGE`], recording
+/// them in `moved`; whether any was moved (module docs, "A singular guess").
+fn move_singular_guesses<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &mut [f64],
+    held: &[usize],
+    moved: &mut Vec<MovedGuess>,
+) -> Result<bool, EvalError> {
+    let info = ws.info();
+    let (n, mh) = (info.nq(), info.nh());
+    if mh == 0 {
+        return Ok(false);
+    }
+    ws.eval_jacobian(mech, t, q)?;
+    let cq = &ws.jacobian()[..mh * n];
+    let largest = cq.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    // Coordinates in no constraint (a free body's position) are never solved for.
+    let constrained = |j: usize| info.holonomic_pattern.iter().any(|&(_, c)| c as usize == j);
+    for j in (0..n).filter(|&j| !held.contains(&j) && constrained(j)) {
+        let column = (0..mh).fold(0.0_f64, |a, i| a.max(cq[i * n + j].abs()));
+        if column <= 1e-12 * largest {
+            let guess = q[j];
+            q[j] = guess + GUESS_NUDGE * guess.abs().max(1.0);
+            moved.push(MovedGuess {
+                coordinate: info.coordinates[j].name,
+                guess,
+                moved_to: q[j],
+            });
+        }
+    }
+    Ok(!moved.is_empty())
 }
 
 impl Kinematics {

@@ -394,10 +394,23 @@ impl Kinematics {
                 break;
             }
         }
-        let violated = scale::unmet(&ws.c, &ws.jacobian, n, tol, scale::coordinate_size(q))
-            .map(|i| info.holonomic[i].name)
-            .collect();
-        let _ = step;
+        let violated: Vec<&'static str> =
+            scale::unmet(&ws.c, &ws.jacobian, n, tol, scale::coordinate_size(q))
+                .map(|i| info.holonomic[i].name)
+                .collect();
+        // Every constraint met, only the updates still moving: a root where the block
+        // of the dependent coordinates is singular (a pendulum in Cartesian
+        // coordinates hanging straight down with `y` held: `x² = 0`, which Newton
+        // halves at each update). The positions meet the constraints to the tolerance,
+        // which is what is asked of them; they are determined there only to about the
+        // square root of it, which no further update changes.
+        if violated.is_empty() && residual.is_finite() {
+            return Ok(NewtonStats {
+                iterations: history.len() - 1,
+                residual,
+                step,
+            });
+        }
         Err(KinematicsError::NewtonFailed {
             t,
             iterations: history.len() - 1,

@@ -66,8 +66,8 @@ pub mod sim;
 mod workspace;
 
 pub use assembly::{
-    AssemblyError, AssemblyReport, OverriddenVelocity, Prescription, StateLevel, Violation,
-    CONSISTENCY_TOLERANCE,
+    AssemblyError, AssemblyReport, MovedGuess, OverriddenVelocity, Prescription, StateLevel,
+    Violation, CONSISTENCY_TOLERANCE, GUESS_NUDGE,
 };
 pub use drawing::{DrawPoint, Drawing, Shape, ShapeKind};
 pub use dynamics::{

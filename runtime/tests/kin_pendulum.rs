@@ -163,6 +163,90 @@ fn assembly_errors_are_clear() {
     assert!((q[1] + 0.8).abs() < 1e-14 && (qd[1] - 0.6).abs() < 1e-14);
 }
 
+/// Holding `x` from a guess where `y` is not determined (y = 0, where ∂C/∂y = 2y
+/// vanishes) holds it anyway: the guess of `y` is moved by `GUESS_NUDGE` in the positive
+/// direction, reported, and Newton reaches the branch y = +0.8 (x² + y² = 1). The
+/// prescribed value is never traded for a guess.
+#[test]
+fn a_prescription_from_a_singular_guess_is_held() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let (mut q, mut qd) = ([1.0, 0.0], [0.0; 2]);
+    let report = kin
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription {
+                coordinates: &[("x", 0.6)],
+                velocities: &[],
+            },
+        )
+        .unwrap();
+    assert_eq!(q[0], 0.6);
+    assert!((q[1] - 0.8).abs() < 1e-14, "{q:?}");
+    assert_eq!(
+        report.moved_guesses,
+        [pfaff::MovedGuess {
+            coordinate: "y",
+            guess: 0.0,
+            moved_to: pfaff::GUESS_NUDGE,
+        }]
+    );
+    // From a guess that serves, nothing is moved.
+    let (mut q, mut qd) = ([0.5, -0.5], [0.0; 2]);
+    let report = kin
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription {
+                coordinates: &[("x", 0.6)],
+                velocities: &[],
+            },
+        )
+        .unwrap();
+    assert!(report.moved_guesses.is_empty());
+    assert!((q[1] + 0.8).abs() < 1e-14, "{q:?}");
+}
+
+/// Holding `y = −1` (hanging straight down) from the guess x = 1 asks Newton for the
+/// double root of x² = 0, where the dependent block 2x vanishes: the updates only halve
+/// x, so they never settle below the tolerance, but the constraint is met to it
+/// (x ≈ 3e-8 after 25 updates, x² ≈ 9e-16). The assembly accepts that state: the
+/// positions meet the constraints, which is what is asked of them.
+#[test]
+fn a_prescription_at_a_double_root_is_assembled() {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let (mut q, mut qd) = ([1.0, 0.0], [0.0; 2]);
+    let report = kin
+        .assemble(
+            &mech,
+            &mut ws,
+            0.0,
+            &mut q,
+            &mut qd,
+            &Prescription {
+                coordinates: &[("y", -1.0)],
+                velocities: &[],
+            },
+        )
+        .unwrap();
+    println!("{report:?} {q:?}");
+    assert_eq!(q[1], -1.0);
+    // Met to the tolerance (1e-14 relative to the row's norm 2): |x| ≤ √(2e-14).
+    assert!((q[0] * q[0] + q[1] * q[1] - 1.0).abs() <= 2e-14);
+    assert!(q[0].abs() < 2e-7, "{q:?}");
+    assert_eq!(qd, [0.0, 0.0]);
+}
+
 /// A full state (every coordinate and velocity) on the constraints is kept as given,
 /// bit for bit, within the consistency tolerance: x = 0.6, y = −0.8 (x² + y² = 1 up to
 /// round-off) turning at 1.5 rad/s, and the same off by 1e-10 relative.

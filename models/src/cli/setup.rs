@@ -162,8 +162,15 @@ pub fn assemble(
             velocities: &velocities,
         };
         match kin.assemble_declared(model, &mut ws, 0.0, &mut qa, &mut qda, &prescription) {
-            Ok((_, overridden)) => {
+            Ok((report, overridden)) => {
                 notes.extend(overridden.iter().map(ToString::to_string));
+                for m in &report.moved_guesses {
+                    let i = info.coordinate_index(m.coordinate).expect("a coordinate");
+                    notes.push(format!(
+                        "{m}; assembled to {} (give `--q0 {}=VALUE` too to choose another solution)",
+                        qa[i], m.coordinate
+                    ));
+                }
                 let size = qa.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
                 for a in &state.q0 {
                     let i = info.coordinate_index(&a.name).expect("checked");
