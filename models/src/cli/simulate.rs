@@ -361,7 +361,7 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
             "position": m.max_position_violation,
             "velocity": m.max_velocity_violation.max(m.max_nonholonomic_violation),
         },
-        "energy": energies(model, run).map_or(Value::Null, |(a, b)| json!({"initial": a, "final": b})),
+        "energy": energies(model, run).map_or(Value::Null, |(a, b)| json!({"initial": a, "final": b, "lost_in_impacts": m.energy_lost_in_impacts})),
         "wall_seconds": out.wall.as_secs_f64(),
         "impacts": impacts::json(info, run),
         "contact_events": impacts::events_json(run),
@@ -464,11 +464,18 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     );
     match (energies(model, run), m.max_energy_drift) {
         (Some((a, b)), drift) => {
+            // The drift of the integration: the impacts' losses set apart.
+            let lost = m.energy_lost_in_impacts;
+            let in_impacts = if lost != 0.0 {
+                format!(", {lost:.10e} J lost in impacts")
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 w,
-                "energy       {a:.10e} -> {b:.10e} J, drift {:.2e} (largest {:.2e})",
-                b - a,
-                drift.unwrap_or((b - a).abs())
+                "energy       {a:.10e} -> {b:.10e} J{in_impacts}, drift {:.2e} (largest {:.2e})",
+                b - a + lost,
+                drift.unwrap_or((b - a + lost).abs())
             );
         }
         (None, _) => {

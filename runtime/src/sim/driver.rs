@@ -372,10 +372,20 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     // Contacts closed at the start: impacts, then rest (none may start penetrated).
     let mut h_first = None;
+    // T + V before those impacts and the kinetic energy they take (positions do not
+    // jump): the run's initial energy is the state's as given.
+    let mut start_energy = None;
     if let Some(c) = sys.contacts.as_mut() {
         if let Err(e) = c.check_initial(&sys.point, t0) {
             return Err(empty(e));
         }
+        let p = &sys.point;
+        let before = info.conservative.then(|| {
+            (
+                mech.energy(t0, &p.q, &p.qd),
+                mech.kinetic_energy(t0, &p.q, &p.qd),
+            )
+        });
         let r = super::contacts::handle(&mut sys, None, t0).and_then(|h| {
             sys.accept(t0)?;
             if let Some(c) = sys.contacts.as_mut() {
@@ -387,6 +397,15 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Ok(h) => h_first = h,
             Err(e) => return Err(empty(e)),
         }
+        start_energy = before.map(|(e, t)| {
+            let p = &sys.point;
+            (e, t - mech.kinetic_energy(t0, &p.q, &p.qd))
+        });
+    }
+    let mut monitors = Monitors::default();
+    if let Some((e, lost)) = start_energy {
+        monitors.energy_initial = Some(e);
+        monitors.energy_lost_in_impacts = lost;
     }
 
     let rows = match sim.output {
@@ -398,7 +417,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     let mut rec = Recorder {
         sys,
         traj: Trajectory::new(info, rows),
-        monitors: Monitors::default(),
+        monitors,
         started,
         y: &mut y,
         overridden,
@@ -604,11 +623,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 .point
                 .mech
                 .kinetic_energy(te, &rec.sys.point.q, &rec.sys.point.qd);
-            // The energy monitor measures the integration: the impacts' losses move its
-            // reference.
-            if let Some(e0) = rec.monitors.energy_initial.as_mut() {
-                *e0 -= before - after;
-            }
+            // The energy monitor measures the integration: the impacts' losses are set
+            // apart from its drift.
+            rec.monitors.energy_lost_in_impacts += before - after;
             if steps_mode {
                 check!(rec.record(te));
             } else {

@@ -203,7 +203,10 @@ pub struct Monitors {
     pub energy_initial: Option<f64>,
     /// $T + V$ at the last accepted state (conservative models only).
     pub energy_final: Option<f64>,
-    /// Largest $|E - E_0|$ (conservative models only).
+    /// Kinetic energy taken by the impacts so far (their `energy_lost`, summed).
+    pub energy_lost_in_impacts: f64,
+    /// Largest $|E - (E_0 - E_\text{impacts})|$ (conservative models only): the drift
+    /// of the integration, the impacts' losses (up to that state) set apart.
     pub max_energy_drift: Option<f64>,
 }
 
@@ -214,7 +217,7 @@ impl Monitors {
         self.max_nonholonomic_violation = self.max_nonholonomic_violation.max(v.2);
         if let Some(e) = energy {
             let e0 = *self.energy_initial.get_or_insert(e);
-            let d = (e - e0).abs();
+            let d = (e - (e0 - self.energy_lost_in_impacts)).abs();
             self.max_energy_drift = Some(self.max_energy_drift.map_or(d, |m| m.max(d)));
         }
     }

@@ -3,7 +3,7 @@
 //! singular impact as a typed error with the run kept. Closed forms are cited per test.
 
 use pfaff::sim::{ContactEventKind, Formulation, Method, Run, SimErrorKind, Simulation};
-use pfaff::{ImpactError, Mechanism};
+use pfaff::{ImpactError, Mechanism, MechanismExt};
 use pfaff_models::{bouncing_ball, falling_rod, newtons_cradle, pendulum_floor};
 
 fn methods() -> Vec<Method> {
@@ -183,6 +183,38 @@ fn contact_closed_at_the_start_is_an_impact_at_t0() {
                 "the first row is after the jump"
             );
         }
+    }
+}
+
+/// The energy monitors of a run with impacts, one of them at t = 0 (`pendulum_floor`,
+/// math-spec V15): the initial energy is that of the state as given, before the jump
+/// at t = 0; the impacts' losses are summed apart (their `energy_lost`, so
+/// E_final = E_initial − lost up to the integration's drift), and the drift excludes
+/// them.
+#[test]
+fn the_energy_monitor_sets_the_impacts_losses_apart() {
+    let model = pendulum_floor::Model::default();
+    let (mut q, mut qd) = (vec![0.0; 6], vec![0.0; 6]);
+    model.initial_state(&mut q, &mut qd);
+    for f in [Formulation::Partitioning, Formulation::Projection] {
+        let r = run(&model, f, Method::Dop853, 0.2);
+        let m = &r.monitors;
+        let given = model.energy(0.0, &q, &qd);
+        let e0 = m.energy_initial.unwrap();
+        assert!(
+            (e0 - given).abs() <= 1e-12 * given.abs().max(1.0),
+            "{e0} {given}"
+        );
+        let lost: f64 = r.impacts.iter().map(|i| i.energy_lost()).sum();
+        assert!(r.impacts[0].t == 0.0 && r.impacts[0].energy_lost() > 0.0);
+        assert!(
+            (m.energy_lost_in_impacts - lost).abs() <= 1e-12 * lost,
+            "{m:?} {lost}"
+        );
+        let e1 = m.energy_final.unwrap();
+        let drift = m.max_energy_drift.unwrap();
+        assert!(drift < 1e-7, "{m:?}");
+        assert!((e1 - (e0 - lost)).abs() <= drift + 1e-12, "{m:?}");
     }
 }
 
