@@ -65,7 +65,13 @@ pub fn summary(info: &Info, run: &Run, w: &mut String) {
     if info.ncontacts() == 0 {
         return;
     }
-    let lost: f64 = run.impacts.iter().map(pfaff::Impact::energy_lost).sum();
+    // From +0 (an empty `sum` of floats is −0, printed "-0"); `+ 0.0` below likewise
+    // prints an impact's −0 as 0.
+    let lost = run
+        .impacts
+        .iter()
+        .map(pfaff::Impact::energy_lost)
+        .fold(0.0, |a, e| a + e);
     let _ = writeln!(
         w,
         "impacts      {} ({} contact{}), energy lost {lost:.6e} J",
@@ -80,15 +86,22 @@ pub fn summary(info: &Info, run: &Run, w: &mut String) {
             super::time(imp.t),
             imp.names.first().copied().unwrap_or(""),
             imp.impulses.first().copied().unwrap_or(0.0),
-            imp.energy_lost()
+            imp.energy_lost() + 0.0
         );
     }
     if run.impacts.len() > LISTED {
         let _ = writeln!(w, "  ... {} more", run.impacts.len() - LISTED);
     }
     for e in &run.contact_events {
+        // Rest after impacts of that contact is their accumulation; a contact closed
+        // without one (at rest on it from the start) simply rests.
+        let struck = run
+            .impacts
+            .iter()
+            .any(|i| i.t <= e.t && i.names.contains(&e.contact));
         let what = match e.kind {
-            ContactEventKind::Rest => "comes to rest (impacts accumulated)",
+            ContactEventKind::Rest if struck => "comes to rest (impacts accumulated)",
+            ContactEventKind::Rest => "rests (closed without an impact)",
             ContactEventKind::Release => "releases (its normal force turned tensile)",
         };
         let _ = writeln!(

@@ -188,7 +188,8 @@ impl Contacts {
         Ok(())
     }
 
-    /// Checks that no contact starts penetrated: every gap at the initial positions of
+    /// Checks every contact's coefficient of restitution (within $[0, 1]$) and that no
+    /// contact starts penetrated: every gap at the initial positions of
     /// `p` is at least $-\varepsilon(1 + \lVert q\rVert_\infty)$ with the consistency
     /// tolerance of a prescribed state ([`crate::assembly::CONSISTENCY_TOLERANCE`]).
     /// A deeper one is an error naming the deepest contact; the resting-contact
@@ -198,6 +199,17 @@ impl Contacts {
         p: &super::point::Point<'_, M>,
         t: f64,
     ) -> Result<(), SimErrorKind> {
+        // A coefficient of restitution outside [0, 1] is refused before the run, not
+        // at the first impact after integrating to it.
+        for contact in self.info.contacts {
+            let value = p.mech.parameter(contact.restitution as usize);
+            if !(0.0..=1.0).contains(&value) {
+                return Err(SimErrorKind::Impact(crate::ImpactError::Restitution {
+                    contact: contact.name,
+                    value,
+                }));
+            }
+        }
         self.gaps_at(p.mech, t, &p.q)?;
         let tolerance = crate::assembly::CONSISTENCY_TOLERANCE * (1.0 + inf_norm(&p.q));
         let deepest = (0..self.g.len())

@@ -614,7 +614,12 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                         c.clear_resting();
                     }
                     let _ = rec.record(te);
-                    return Err(rec.fail(None, kind));
+                    // The work of the steps to the event is counted (the stepper's);
+                    // the row at the event is the last.
+                    return Err(SimError {
+                        kind,
+                        partial: Box::new(rec.run(Some(&stepper))),
+                    });
                 }
             };
             check!(rec.sys.accept(te));

@@ -269,6 +269,31 @@ fn singular_impact_stops_the_run_with_the_constraints_named() {
     let tr = &err.partial.trajectory;
     assert!(tr.len() > 10, "rows kept: {}", tr.len());
     assert!(*tr.t.last().unwrap() <= t_hit + 1e-9);
+    // The work of the steps to the impact is reported with the run kept.
+    let s = &err.partial.stats;
+    assert!(s.steps > 0 && s.rhs_evals > s.steps, "{s:?}");
+}
+
+/// A coefficient of restitution outside [0, 1] is refused before the run starts (the
+/// bouncing ball with e = 1.5 would otherwise fly 0.45 s to its first impact).
+#[test]
+fn a_restitution_outside_the_unit_interval_is_refused_at_the_start() {
+    let mut model = bouncing_ball::Model::default();
+    let e = model
+        .info()
+        .parameter_index("e")
+        .expect("the model's restitution");
+    model.set_parameter(e, 1.5);
+    let err = Simulation::new(&model).run(1.0).expect_err("e = 1.5");
+    assert!(
+        matches!(
+            err.kind,
+            SimErrorKind::Impact(ImpactError::Restitution { contact: "floor", value }) if value == 1.5
+        ),
+        "{err}"
+    );
+    assert!(err.partial.trajectory.is_empty());
+    assert_eq!(err.partial.stats.steps, 0);
 }
 
 /// RK4 at a fixed step locates the impacts on its dense output as well; the rest comes
