@@ -17,9 +17,10 @@
 //! $C_q$ vanishes at the guess are moved by [`GUESS_NUDGE`] (relative) and the
 //! partition is tried once more; those it leaves independent go back to their guesses,
 //! Newton solves for the others from the moved values, and
-//! [`AssemblyReport::moved_guesses`] lists them (the branch reached, here $y = +0.8$,
-//! follows the direction of the move). If the partition fails again, the first error
-//! stands.
+//! [`AssemblyReport::moved_guesses`] lists them. A guess moves toward the lower
+//! potential energy where the potential depends on it (the pendulum's `y` down, to the
+//! branch $y = -0.8$ it hangs on), up otherwise; the branch reached follows the move.
+//! If the partition fails again, the first error stands.
 //!
 //! **A full state.** When every coordinate is prescribed there is nothing to solve: the
 //! values are checked against the constraints instead, each row $i$ within
@@ -107,7 +108,7 @@ pub struct AssemblyReport {
 }
 
 /// The relative size of the move of a singular guess: a coordinate's guess $g$ moves
-/// to $g + 10^{-3}\max(1, |g|)$ (module docs, "A singular guess").
+/// to $g \pm 10^{-3}\max(1, |g|)$ (module docs, "A singular guess").
 pub const GUESS_NUDGE: f64 = 1e-3;
 
 /// A guess moved by the assembly (see [`AssemblyReport::moved_guesses`]).
@@ -406,8 +407,20 @@ fn move_singular_guesses<M: Mechanism + ?Sized>(
     for j in (0..n).filter(|&j| !held.contains(&j) && constrained(j)) {
         let column = (0..mh).fold(0.0_f64, |a, i| a.max(cq[i * n + j].abs()));
         if column <= 1e-12 * largest {
+            // Toward the lower potential energy (a pendulum's guess moves down, to the
+            // branch it hangs on); up where the potential does not depend on it.
             let guess = q[j];
-            q[j] = guess + GUESS_NUDGE * guess.abs().max(1.0);
+            let delta = GUESS_NUDGE * guess.abs().max(1.0);
+            let mut potential = |x: f64| {
+                q[j] = x;
+                mech.potential_energy(t, q)
+            };
+            let (up, down) = (potential(guess + delta), potential(guess - delta));
+            q[j] = if down < up {
+                guess - delta
+            } else {
+                guess + delta
+            };
             moved.push(MovedGuess {
                 coordinate: info.coordinates[j].name,
                 guess,

@@ -164,9 +164,9 @@ fn assembly_errors_are_clear() {
 }
 
 /// Holding `x` from a guess where `y` is not determined (y = 0, where ∂C/∂y = 2y
-/// vanishes) holds it anyway: the guess of `y` is moved by `GUESS_NUDGE` in the positive
-/// direction, reported, and Newton reaches the branch y = +0.8 (x² + y² = 1). The
-/// prescribed value is never traded for a guess.
+/// vanishes) holds it anyway: the guess of `y` is moved by `GUESS_NUDGE` toward the
+/// lower potential energy (down: gravity along −y), reported, and Newton reaches the
+/// branch y = −0.8 (x² + y² = 1). The prescribed value is never traded for a guess.
 #[test]
 fn a_prescription_from_a_singular_guess_is_held() {
     let mech = Pendulum::new(false);
@@ -187,13 +187,13 @@ fn a_prescription_from_a_singular_guess_is_held() {
         )
         .unwrap();
     assert_eq!(q[0], 0.6);
-    assert!((q[1] - 0.8).abs() < 1e-14, "{q:?}");
+    assert!((q[1] + 0.8).abs() < 1e-14, "{q:?}");
     assert_eq!(
         report.moved_guesses,
         [pfaff::MovedGuess {
             coordinate: "y",
             guess: 0.0,
-            moved_to: pfaff::GUESS_NUDGE,
+            moved_to: -pfaff::GUESS_NUDGE,
         }]
     );
     // From a guess that serves, nothing is moved.

@@ -198,7 +198,8 @@ pub struct LinearizeArgs {
     pub model: String,
     #[command(flatten)]
     pub state: StateArgs,
-    /// Forward speed of the steady motion, for models that define one (sleigh).
+    /// Forward speed of the steady motion, for models that define one (sleigh,
+    /// rolling_disk, bicycle).
     #[arg(long, value_name = "V", allow_negative_numbers = true)]
     pub speed: Option<f64>,
     /// Print one JSON object on stdout.

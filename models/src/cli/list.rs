@@ -9,9 +9,16 @@ use super::setup;
 /// The table of `pfaff list`.
 pub fn list() -> String {
     let mut w = String::new();
+    // The name column as wide as the longest name.
+    let width = pfaff_models::all()
+        .iter()
+        .map(|e| e.name.len())
+        .max()
+        .unwrap_or(0)
+        .max("model".len());
     let _ = writeln!(
         w,
-        "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  description",
+        "{:<width$} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  description",
         "model", "nq", "hol", "nhol", "contacts", "t_end", "bodies", "joints"
     );
     for e in pfaff_models::all() {
@@ -19,7 +26,7 @@ pub fn list() -> String {
         let info = model.info();
         let _ = writeln!(
             w,
-            "{:<16} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  {}",
+            "{:<width$} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  {}",
             e.name,
             info.nq(),
             info.nh(),

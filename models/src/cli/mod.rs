@@ -81,7 +81,16 @@ fn one_line(e: &clap::Error) -> String {
         .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
         .filter(|l| !l.is_empty())
         .collect();
-    lines.join("; ").trim_start_matches("error: ").to_owned()
+    // A line that ends in a colon introduces the next (clap's "were not provided:"
+    // before the missing argument): joined with a space, not "; ".
+    let mut one = String::new();
+    for l in lines {
+        if !one.is_empty() {
+            one.push_str(if one.ends_with(':') { " " } else { "; " });
+        }
+        one.push_str(l);
+    }
+    one.trim_start_matches("error: ").to_owned()
 }
 
 /// Joins `--flag -1e-6` into `--flag=-1e-6`: clap takes `-1e-6` for a short option

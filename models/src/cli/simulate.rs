@@ -359,7 +359,8 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
         },
         "max_violation": {
             "position": m.max_position_violation,
-            "velocity": m.max_velocity_violation.max(m.max_nonholonomic_violation),
+            "velocity": m.max_velocity_violation,
+            "nonholonomic": m.max_nonholonomic_violation,
         },
         "energy": energies(model, run).map_or(Value::Null, |(a, b)| json!({"initial": a, "final": b, "lost_in_impacts": m.energy_lost_in_impacts})),
         "wall_seconds": out.wall.as_secs_f64(),
