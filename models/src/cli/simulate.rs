@@ -89,8 +89,20 @@ pub fn request<'a>(
                 super::time(t_end)
             ));
         }
+        if t_end > 0.0 && h > t_end {
+            notes.push(format!(
+                "--step {h:e} is longer than the span [0, {}] s: the first step is the span",
+                super::time(t_end)
+            ));
+        }
         h.max(min)
     });
+    if args.rtol < 4.0 * f64::EPSILON {
+        notes.push(format!(
+            "--rtol {:e} is below what double precision resolves (about 1e-15 relative): the run's error is set by round-off, not by the tolerance",
+            args.rtol
+        ));
+    }
     if args.samples == 0 || args.samples > MAX_SAMPLES {
         return Err(usage(format!(
             "invalid --samples {}: expected 1 to {MAX_SAMPLES} (longer records are for the library's `Trajectory`)",
