@@ -241,10 +241,16 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         }
     }
 
-    fn fail(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
+    fn fail(&mut self, stepper: Option<&Stepper>, kind: SimErrorKind) -> SimError {
         if let Some(s) = stepper {
             self.record_last_accepted(s);
         }
+        self.failed(stepper, kind)
+    }
+
+    /// [`fail`](Self::fail) with the rows as recorded (the last one already the state
+    /// the run stops at), the work of `stepper`'s steps counted.
+    fn failed(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
         if let SimErrorKind::NewtonFailed { constraints, .. }
         | SimErrorKind::Singular { constraints, .. } = &mut kind
         {
@@ -614,12 +620,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                         c.clear_resting();
                     }
                     let _ = rec.record(te);
-                    // The work of the steps to the event is counted (the stepper's);
-                    // the row at the event is the last.
-                    return Err(SimError {
-                        kind,
-                        partial: Box::new(rec.run(Some(&stepper))),
-                    });
+                    // The row at the event is the last; the work of the steps to it
+                    // is counted.
+                    return Err(rec.failed(Some(&stepper), kind));
                 }
             };
             check!(rec.sys.accept(te));
