@@ -437,3 +437,56 @@ fn impact_time_error_falls_with_the_tolerance() {
     let run = Simulation::new(&model).run(0.5).expect("runs");
     assert_eq!(reference.impact_time_error(&run), Some(f64::INFINITY));
 }
+
+/// A fixed-step RK4 run of the bouncing ball (h = 1, e = 0.5, g = 9.81; h_step = 2 ms)
+/// merges the last, shortest flights of the accumulation into the rest: it strikes 12
+/// times, not the 20 of the closed form (t_n = T(1 + 2 Σ_{k<n} e^k), T = √(2h/g), the
+/// list that `pfaff work-precision bouncing_ball` uses). The impacts it did not strike
+/// after coming to rest are compared with its rest time, a finite error below the
+/// distance from its rest to the accumulation time t∞ = T(1 + e)/(1 − e), instead of
+/// an infinite one.
+#[test]
+fn impacts_merged_into_the_rest_count_from_the_rest_time() {
+    use pfaff::sim::Reference;
+    let model = bouncing_ball::Model::default();
+    let (e, g, h) = (0.5_f64, 9.81_f64, 1.0_f64);
+    let t1 = (2.0 * h / g).sqrt();
+    let mut impacts = Vec::new();
+    let (mut t, mut flight) = (t1, 2.0 * t1);
+    for _ in 0..20 {
+        impacts.push(("floor".to_owned(), t));
+        flight *= e;
+        t += flight;
+    }
+    let t_inf = t1 * (1.0 + e) / (1.0 - e);
+    let reference = Reference {
+        coordinates: vec![],
+        velocities: vec![],
+        impacts,
+    };
+    let run = Simulation::new(&model)
+        .integrator(Method::Rk4 { h: 0.002 })
+        .output_times(&[])
+        .run(2.0)
+        .expect("runs");
+    let rest = run
+        .contact_events
+        .iter()
+        .find(|c| matches!(c.kind, ContactEventKind::Rest))
+        .expect("the ball comes to rest");
+    assert!(run.impacts.len() < 20, "{}", run.impacts.len());
+    let err = reference
+        .impact_time_error(&run)
+        .expect("impacts to compare");
+    println!(
+        "{} impacts, rest at {}, error {err:e}",
+        run.impacts.len(),
+        rest.t
+    );
+    assert!(
+        err.is_finite() && err <= t_inf - rest.t + 1e-12,
+        "{err} {}",
+        rest.t
+    );
+    assert!(err > 0.0);
+}
