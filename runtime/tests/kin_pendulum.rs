@@ -163,29 +163,30 @@ fn assembly_errors_are_clear() {
     assert!((q[1] + 0.8).abs() < 1e-14 && (qd[1] - 0.6).abs() < 1e-14);
 }
 
+/// Assembles the Cartesian pendulum from the guess `q` (at rest) with the coordinates
+/// `held`: the report, positions and velocities.
+fn assemble_from(q: [f64; 2], held: &[(&str, f64)]) -> (pfaff::AssemblyReport, [f64; 2], [f64; 2]) {
+    let mech = Pendulum::new(false);
+    let mut ws = Workspace::new(mech.info()).unwrap();
+    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
+    let (mut q, mut qd) = (q, [0.0; 2]);
+    let prescription = Prescription {
+        coordinates: held,
+        velocities: &[],
+    };
+    let report = kin
+        .assemble(&mech, &mut ws, 0.0, &mut q, &mut qd, &prescription)
+        .unwrap();
+    (report, q, qd)
+}
+
 /// Holding `x` from a guess where `y` is not determined (y = 0, where ∂C/∂y = 2y
 /// vanishes) holds it anyway: the guess of `y` is moved by `GUESS_NUDGE` toward the
 /// lower potential energy (down: gravity along −y), reported, and Newton reaches the
 /// branch y = −0.8 (x² + y² = 1). The prescribed value is never traded for a guess.
 #[test]
 fn a_prescription_from_a_singular_guess_is_held() {
-    let mech = Pendulum::new(false);
-    let mut ws = Workspace::new(mech.info()).unwrap();
-    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
-    let (mut q, mut qd) = ([1.0, 0.0], [0.0; 2]);
-    let report = kin
-        .assemble(
-            &mech,
-            &mut ws,
-            0.0,
-            &mut q,
-            &mut qd,
-            &Prescription {
-                coordinates: &[("x", 0.6)],
-                velocities: &[],
-            },
-        )
-        .unwrap();
+    let (report, q, _) = assemble_from([1.0, 0.0], &[("x", 0.6)]);
     assert_eq!(q[0], 0.6);
     assert!((q[1] + 0.8).abs() < 1e-14, "{q:?}");
     assert_eq!(
@@ -197,20 +198,7 @@ fn a_prescription_from_a_singular_guess_is_held() {
         }]
     );
     // From a guess that serves, nothing is moved.
-    let (mut q, mut qd) = ([0.5, -0.5], [0.0; 2]);
-    let report = kin
-        .assemble(
-            &mech,
-            &mut ws,
-            0.0,
-            &mut q,
-            &mut qd,
-            &Prescription {
-                coordinates: &[("x", 0.6)],
-                velocities: &[],
-            },
-        )
-        .unwrap();
+    let (report, q, _) = assemble_from([0.5, -0.5], &[("x", 0.6)]);
     assert!(report.moved_guesses.is_empty());
     assert!((q[1] + 0.8).abs() < 1e-14, "{q:?}");
 }
@@ -222,23 +210,7 @@ fn a_prescription_from_a_singular_guess_is_held() {
 /// positions meet the constraints, which is what is asked of them.
 #[test]
 fn a_prescription_at_a_double_root_is_assembled() {
-    let mech = Pendulum::new(false);
-    let mut ws = Workspace::new(mech.info()).unwrap();
-    let mut kin = Kinematics::new(mech.info(), KinematicsParams::default());
-    let (mut q, mut qd) = ([1.0, 0.0], [0.0; 2]);
-    let report = kin
-        .assemble(
-            &mech,
-            &mut ws,
-            0.0,
-            &mut q,
-            &mut qd,
-            &Prescription {
-                coordinates: &[("y", -1.0)],
-                velocities: &[],
-            },
-        )
-        .unwrap();
+    let (report, q, qd) = assemble_from([1.0, 0.0], &[("y", -1.0)]);
     println!("{report:?} {q:?}");
     assert_eq!(q[1], -1.0);
     // Met to the tolerance (1e-14 relative to the row's norm 2): |x| ≤ √(2e-14).

@@ -387,10 +387,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         }
         let p = &sys.point;
         let before = info.conservative.then(|| {
-            (
-                mech.energy(t0, &p.q, &p.qd),
-                mech.kinetic_energy(t0, &p.q, &p.qd),
-            )
+            let kinetic = mech.kinetic_energy(t0, &p.q, &p.qd);
+            (kinetic + mech.potential_energy(t0, &p.q), kinetic)
         });
         let r = super::contacts::handle(&mut sys, None, t0).and_then(|h| {
             sys.accept(t0)?;

@@ -84,10 +84,10 @@ impl Reference {
                         && e.t <= *t
                 })
             };
-            match (found, rest()) {
-                (Some(i), _) => err = err.max((i.t - t).abs()),
-                (None, Some(e)) => err = err.max((e.t - t).abs()),
-                (None, None) => return Some(f64::INFINITY),
+            // The strike, or else the rest that took its place (looked for only then).
+            match found.map(|i| i.t).or_else(|| rest().map(|e| e.t)) {
+                Some(at) => err = err.max((at - t).abs()),
+                None => return Some(f64::INFINITY),
             }
         }
         Some(err)
