@@ -216,12 +216,14 @@ pub struct Dynamics {
     /// suggest a singular matrix. Allocated by [`Dynamics::new`] when there is no
     /// generated solve to try first, else at the first solve that needs them (most
     /// runs of a model with a generated solve never do: ten allocations fewer per run).
-    small: Option<SmallLu>,
-    dense: Option<DenseLu>,
-    sparse: Option<SparseKkt>,
+    /// Boxed, like the sparse factors: a model takes one path, and the structure that
+    /// holds the others inline is moved whole while a run is set up.
+    small: Option<Box<SmallLu>>,
+    dense: Option<Box<DenseLu>>,
+    sparse: Option<Box<SparseKkt>>,
     /// The sparse $LDL^\mathsf{T}$ tried before the sparse $LU$ (`None` for
     /// [`LinearSolver::SparseLu`], and when its symbolic factorization is not possible).
-    ldlt: Option<SparseLdlt>,
+    ldlt: Option<Box<SparseLdlt>>,
     /// Whether to try the model's generated solve (cleared when it has none).
     generated: bool,
     x: Vec<f64>,
@@ -362,15 +364,17 @@ impl Dynamics {
             LinearSolver::Auto => (dim < params.crossover, dim >= params.crossover),
         };
         let sparse = if sparse {
-            Some(SparseKkt::new(info).map_err(|e| DynamicsError::Symbolic {
-                model: info.name,
-                reason: format!("{e:?}"),
-            })?)
+            Some(Box::new(SparseKkt::new(info).map_err(|e| {
+                DynamicsError::Symbolic {
+                    model: info.name,
+                    reason: format!("{e:?}"),
+                }
+            })?))
         } else {
             None
         };
         let ldlt = if sparse.is_some() && params.solver != LinearSolver::SparseLu {
-            SparseLdlt::new(info)
+            SparseLdlt::new(info).map(Box::new)
         } else {
             None
         };
@@ -379,8 +383,8 @@ impl Dynamics {
             params,
             info,
             dense_path: dense,
-            small: eager.then(|| SmallLu::new(dim)),
-            dense: eager.then(|| DenseLu::new(dim, 1)),
+            small: eager.then(|| Box::new(SmallLu::new(dim))),
+            dense: eager.then(|| Box::new(DenseLu::new(dim, 1))),
             sparse,
             ldlt,
             generated: params.solver == LinearSolver::Auto,
@@ -402,7 +406,7 @@ impl Dynamics {
     /// Stored entries of the sparse augmented matrix (0 when the sparse path is off).
     #[must_use]
     pub fn sparse_nnz(&self) -> usize {
-        self.sparse.as_ref().map_or(0, SparseKkt::nnz)
+        self.sparse.as_ref().map_or(0, |k| k.nnz())
     }
 
     /// Constraints found redundant by the last solve (empty unless its path was
@@ -689,8 +693,8 @@ impl Dynamics {
     #[inline(never)]
     fn allocate_dense(&mut self) {
         let dim = self.x.len();
-        self.small = Some(SmallLu::new(dim));
-        self.dense = Some(DenseLu::new(dim, 1));
+        self.small = Some(Box::new(SmallLu::new(dim)));
+        self.dense = Some(Box::new(DenseLu::new(dim, 1)));
     }
 
     /// Checks the solution in `x` and hands it out as `out` $= [\ddot q; \lambda]$.

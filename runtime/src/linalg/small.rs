@@ -570,25 +570,29 @@ impl GramPlan {
     pub fn new(rows: &[usize], n: usize, nonzero: impl Fn(usize, usize) -> bool) -> Self {
         let r = rows.len();
         let index = |v: usize| u32::try_from(v).expect("a matrix of fewer than 2^32 entries");
-        // Counted first, so that the plan is one allocation of its size.
-        let mut count = 0;
-        for j in 0..n {
-            for (i, &ri) in rows.iter().enumerate() {
-                if nonzero(ri, j) {
-                    count += rows[..=i].iter().filter(|&&rk| nonzero(rk, j)).count();
-                }
-            }
-        }
+        // Each column's rows (places in `rows`, ascending) with an entry there: every
+        // pair of them is a product, in the dense loop's order. Counted first, so that
+        // the plan is one allocation of its size.
+        let nonzero = &nonzero;
+        let in_column = |j: usize| (0..r).filter(move |&i| nonzero(rows[i], j));
+        let count = (0..n)
+            .map(|j| {
+                let c = in_column(j).count();
+                c * (c + 1) / 2
+            })
+            .sum();
         let mut products = Vec::with_capacity(count);
+        let mut column = Vec::with_capacity(r);
         for j in 0..n {
-            for (i, &ri) in rows.iter().enumerate() {
-                if !nonzero(ri, j) {
-                    continue;
-                }
-                for (k, &rk) in rows[..=i].iter().enumerate() {
-                    if nonzero(rk, j) {
-                        products.push((index(i * r + k), index(ri * n + j), index(rk * n + j)));
-                    }
+            column.clear();
+            column.extend(in_column(j));
+            for (a, &i) in column.iter().enumerate() {
+                for &k in &column[..=a] {
+                    products.push((
+                        index(i * r + k),
+                        index(rows[i] * n + j),
+                        index(rows[k] * n + j),
+                    ));
                 }
             }
         }

@@ -29,6 +29,9 @@ use super::system::OdeSystem;
 /// Index of the FSAL stage $f(t+h, y_{n+1})$ in `k`.
 const FSAL: usize = 12;
 
+/// Index in `k` of the first of the three stages only the dense output evaluates.
+const DENSE_STAGES: usize = 13;
+
 /// Dormand–Prince 8(5,3) with dense output of order 7.
 #[derive(Clone, Debug)]
 pub struct Dop853(RkDriver<Dp853>);
@@ -41,9 +44,11 @@ pub(crate) struct Dp853 {
     /// With `dense_output`, the interpolant is prepared only on the steps that reach
     /// this time (every step when `None`), see [`Dop853::dense_output_from`].
     dense_from: Option<f64>,
-    /// Stage derivatives 1–16 (index = stage − 1).
+    /// Stage derivatives 1–16 (index = stage − 1); stages 14–16 empty without
+    /// `dense_output`.
     k: [Vec<f64>; 16],
-    /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f).
+    /// Coefficients of the interpolant on the last step (`rcont1..8` of dop853.f);
+    /// empty without `dense_output`.
     cont: [Vec<f64>; 8],
 }
 
@@ -109,13 +114,16 @@ impl Dop853 {
     /// # Errors
     /// Invalid options, see [`OdeOptions::validate`].
     pub fn new(dim: usize, opts: OdeOptions) -> Result<Self, OdeError> {
-        let v = || vec![0.0; dim];
+        // The three dense stages and the interpolant only serve `dense_output`, which
+        // is fixed for the integrator's life: without it they stay empty (eleven
+        // allocations fewer per run).
+        let dense = if opts.dense_output { dim } else { 0 };
         let ctrl = PiController::gustafsson(8.0, 0.333, 6.0);
         let m = Dp853 {
             dense_ready: false,
             dense_from: None,
-            k: std::array::from_fn(|_| v()),
-            cont: std::array::from_fn(|_| v()),
+            k: std::array::from_fn(|s| vec![0.0; if s < DENSE_STAGES { dim } else { dense }]),
+            cont: std::array::from_fn(|_| vec![0.0; dense]),
         };
         RkDriver::new(dim, opts, ctrl, m).map(Self)
     }
@@ -158,7 +166,7 @@ impl Dp853 {
         h: f64,
     ) -> Result<(), OdeError> {
         sys.aside(true);
-        let stages = (13..16).try_for_each(|s| self.stage(st, sys, s, h));
+        let stages = (DENSE_STAGES..16).try_for_each(|s| self.stage(st, sys, s, h));
         sys.aside(false);
         stages?;
         let [c1, c2, c3, c4, rest @ ..] = &mut self.cont;

@@ -76,7 +76,8 @@ pub(crate) struct Dp5 {
     /// Stage derivatives 1–7 (index = stage − 1).
     k: [Vec<f64>; 7],
     /// Coefficients of the interpolant on the last step (`rcont1..5` of dopri5.f),
-    /// row `r` at `r * n..(r + 1) * n`.
+    /// row `r` at `r * n..(r + 1) * n`; empty without `dense_output` (fixed for the
+    /// integrator's life).
     cont: Vec<f64>,
 }
 
@@ -91,7 +92,7 @@ impl Dopri5 {
             dense_ready: false,
             dense_from: None,
             k: std::array::from_fn(|_| vec![0.0; dim]),
-            cont: vec![0.0; 5 * dim],
+            cont: vec![0.0; if opts.dense_output { 5 * dim } else { 0 }],
         };
         RkDriver::new(dim, opts, ctrl, m).map(Self)
     }
