@@ -458,3 +458,71 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
         nonholonomic: ph2.ratio(m - mh),
     })
 }
+
+/// The holonomic constraints that take part in the near dependence of the rows of
+/// $C_q(q, t)$, for naming them in an error: the first of `ratios` below which some
+/// singular value $\sigma_k$ of $C_q$ (its rows scaled to unit length, so that the
+/// units of the constraints do not count) lies relative to the largest, the left
+/// singular vectors $u_k$ of all such values, and the rows whose entries in them reach
+/// a tenth of their largest ($\sum_i u_{ik}\,\text{row}_i \approx 0$ is the dependent
+/// combination), most involved first. Empty when no ratio finds a dependence (or
+/// $C_q$ cannot be evaluated).
+///
+/// Complete pivoting names one row of the set only (the one left without a pivot,
+/// which depends on the pivots' order): a driven slider-crank whose crank is longer
+/// than its coupler locks with the coupler vertical, where the vertical rows of the
+/// loop and the slider's guide are dependent together. Allocates (an error path).
+pub(crate) fn dependent_constraints<M: Mechanism + ?Sized>(
+    mech: &M,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    ratios: &[f64],
+) -> Vec<&'static str> {
+    let info = ws.info();
+    let (n, mh) = (info.nq(), info.nh());
+    if mh == 0 || ws.eval_jacobian(mech, t, q).is_err() {
+        return Vec::new();
+    }
+    let jacobian = &ws.jacobian[..mh * n];
+    let norms: Vec<f64> = (0..mh)
+        .map(|i| {
+            let row = &jacobian[i * n..(i + 1) * n];
+            row.iter().map(|x| x * x).sum::<f64>().sqrt()
+        })
+        .collect();
+    if norms.iter().any(|s| !s.is_finite()) {
+        return Vec::new();
+    }
+    // A zero row is dependent by itself; the others are scaled to unit length.
+    let a = faer::Mat::from_fn(mh, n, |i, j| {
+        if norms[i] > 0.0 {
+            jacobian[i * n + j] / norms[i]
+        } else {
+            0.0
+        }
+    });
+    let Ok(svd) = a.svd() else {
+        return Vec::new();
+    };
+    let (u, s) = (svd.U(), svd.S().column_vector());
+    let largest = if s.nrows() > 0 { s[0] } else { 0.0 };
+    // The full U has mh columns; the singular values beyond min(mh, n) are 0.
+    let sigma = |k: usize| if k < s.nrows() { s[k] } else { 0.0 };
+    for &ratio in ratios {
+        let weak: Vec<usize> = (0..mh).filter(|&k| sigma(k) <= ratio * largest).collect();
+        if weak.is_empty() {
+            continue;
+        }
+        let weight: Vec<f64> = (0..mh)
+            .map(|i| weak.iter().fold(0.0_f64, |w, &k| w.max(u[(i, k)].abs())))
+            .collect();
+        let top = weight.iter().fold(0.0_f64, |w, &x| w.max(x));
+        let mut rows: Vec<usize> = (0..mh)
+            .filter(|&i| norms[i] == 0.0 || weight[i] >= 0.1 * top)
+            .collect();
+        rows.sort_by(|&i, &k| weight[k].total_cmp(&weight[i]));
+        return rows.into_iter().map(|i| info.holonomic[i].name).collect();
+    }
+    Vec::new()
+}

@@ -413,6 +413,13 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
         if dof == 1 { "" } else { "s" }
     );
     let tol = match req.method {
+        // RK4 halves an attempt whose evaluation failed recoverably (a Newton failure of
+        // the chart); the next step has the nominal size again.
+        Method::Rk4 { h } if s.rejected > 0 => format!(
+            "fixed step {h:e} s ({} attempt{} halved after a failed evaluation)",
+            s.rejected,
+            if s.rejected == 1 { "" } else { "s" }
+        ),
         Method::Rk4 { h } => format!("fixed step {h:e} s"),
         _ => format!("rtol {:e}, atol {:e}", req.args.rtol, req.args.atol),
     };

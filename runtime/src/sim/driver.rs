@@ -28,13 +28,10 @@ use crate::assembly::write_prescription;
 use crate::kinematics::KinematicsError;
 use crate::ode::{OdeError, OdeOptions, OdeSystem, Tolerances};
 use crate::workspace::EvalError;
-use crate::{
-    AssemblyError, Mechanism, MechanismExt, Partition, PartitionError, PartitionParams,
-    Preferences, Prescription,
-};
+use crate::{AssemblyError, Mechanism, MechanismExt, PartitionError, Prescription};
 
-/// Pivot ratios below which constraints are reported as nearly dependent in a failure,
-/// tried in turn.
+/// Ratios of a singular value of $C_q$ (rows at unit length) to the largest below
+/// which constraints are reported as nearly dependent in a failure, tried in turn.
 const NEAR_SINGULAR: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
 /// Most rows an [`Output::Every`] grid may ask for: a finer grid is a mistake (a unit
@@ -138,30 +135,19 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         kept
     }
 
-    /// The holonomic constraints that Algorithm P finds nearly dependent (pivot ratio
-    /// below the first of [`NEAR_SINGULAR`] that finds any) at the last full state:
-    /// those that lock the mechanism when an iteration stalls on a singular Jacobian
-    /// with a small residual.
+    /// The holonomic constraints that take part in a near dependence of $C_q$ at the
+    /// last full state ([`crate::partition::dependent_constraints`], singular values
+    /// below the first of [`NEAR_SINGULAR`] that finds any): those that lock the
+    /// mechanism when an iteration stalls on a singular Jacobian with a small residual.
     fn nearly_dependent(&mut self) -> Vec<&'static str> {
         let p = &mut self.sys.point;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
         };
         p.invalidate();
-        // The weakest rows first: a stall near a fold (a slider at its reach) leaves a
-        // pivot ratio of a few 1e-3 at the last accepted state.
-        for tolerance in NEAR_SINGULAR {
-            let params = PartitionParams {
-                pivot_tolerance: tolerance,
-                ..PartitionParams::default()
-            };
-            if let Err(PartitionError::RedundantHolonomic { constraints, .. }) =
-                Partition::compute(p.mech, &mut p.ws, t, &p.q, Preferences::default(), &params)
-            {
-                return constraints;
-            }
-        }
-        Vec::new()
+        // The weakest dependence first: a stall near a fold (a slider at its reach)
+        // leaves a pivot ratio of a few 1e-3 at the last accepted state.
+        crate::partition::dependent_constraints(p.mech, &mut p.ws, t, &p.q, &NEAR_SINGULAR)
     }
 
     /// Adds a row at the integrator's last accepted state when the rows end before it

@@ -147,8 +147,8 @@ pub enum SimErrorKind {
         /// Final $\lVert C\rVert_\infty$.
         residual: f64,
         /// Constraints whose residual exceeds the tolerance, or else (a stall on a
-        /// singular Jacobian) those Algorithm P finds nearly dependent at the last
-        /// recorded state.
+        /// singular Jacobian) those that take part in a near dependence of $C_q$ at the
+        /// last recorded state (its left singular vectors, see `partition`).
         constraints: Vec<&'static str>,
     },
     /// A matrix became singular.
@@ -161,7 +161,8 @@ pub enum SimErrorKind {
         /// Smallest / largest pivot.
         ratio: f64,
         /// Holonomic constraints whose residual exceeded the tolerance at that point,
-        /// or else those Algorithm P finds nearly dependent at the last recorded state.
+        /// or else those that take part in a near dependence of $C_q$ at the last
+        /// recorded state (its left singular vectors: the whole dependent set).
         constraints: Vec<&'static str>,
     },
     /// The augmented matrix of (E31) is singular while $J$ has full rank: the mass

@@ -447,3 +447,42 @@ fn a_massless_bob_blames_the_mass_matrix() {
         }
     }
 }
+
+/// A driven slider-crank whose crank is longer than its coupler (`a = 0.35 > b = 0.3`)
+/// locks when the crank tip rises to `b` above the guide: the coupler is vertical
+/// (`phi2 = -pi/2`), so the vertical closure of the loop, `a sin(phi1) + b sin(phi2) =
+/// 0`, no longer depends on `phi2` and restates the driver's prescription of `phi1`.
+/// Its rows (`pin_o_y`, `pin_a_y`, `pin_b_y`, `guide_y`) and the driver are the
+/// dependent set; the horizontal rows and the slider's angle take no part. The
+/// failure names that set, not the one row complete pivoting happens to leave
+/// without a pivot (it named `guide_y` alone).
+#[test]
+fn a_lock_names_the_dependent_set_of_constraints() {
+    let mut model = pfaff_models::slider_crank::Model::default();
+    let a = model.info().parameter_index("a").unwrap();
+    model.set_parameter(a, 0.35);
+    for formulation in [Formulation::Partitioning, Formulation::Projection] {
+        let err = Simulation::new(&model)
+            .formulation(formulation)
+            .run(0.2)
+            .unwrap_err();
+        let SimErrorKind::Singular { t, constraints, .. } = &err.kind else {
+            panic!("{}: {err}", formulation.name());
+        };
+        // The lock: sin(phi1) = b / a with phi1 = pi/6 + 10 t (the driver).
+        let lock = ((0.3_f64 / 0.35).asin() - std::f64::consts::FRAC_PI_6) / 10.0;
+        assert!(
+            (t - lock).abs() < 1e-3,
+            "{}: t = {t}, lock at {lock}",
+            formulation.name()
+        );
+        let mut named = constraints.clone();
+        named.sort_unstable();
+        assert_eq!(
+            named,
+            ["driver", "guide_y", "pin_a_y", "pin_b_y", "pin_o_y"],
+            "{}: {err}",
+            formulation.name()
+        );
+    }
+}
