@@ -137,9 +137,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
 
     /// The holonomic constraints that take part in a near dependence of $C_q$ at the
     /// last full state ([`crate::partition::dependent_constraints`], singular values
-    /// below the first of [`NEAR_SINGULAR`] that finds any): those that lock the
+    /// below the first of `ratios` that finds any): those that lock the
     /// mechanism when an iteration stalls on a singular Jacobian with a small residual.
-    fn nearly_dependent(&mut self) -> Vec<&'static str> {
+    fn nearly_dependent(&mut self, ratios: &[f64]) -> Vec<&'static str> {
         let p = &mut self.sys.point;
         let Some(&t) = self.traj.t.last() else {
             return Vec::new();
@@ -147,7 +147,7 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         p.invalidate();
         // The weakest dependence first: a stall near a fold (a slider at its reach)
         // leaves a pivot ratio of a few 1e-3 at the last accepted state.
-        crate::partition::dependent_constraints(p.mech, &mut p.ws, t, &p.q, &NEAR_SINGULAR)
+        crate::partition::dependent_constraints(p.mech, &mut p.ws, t, &p.q, ratios)
     }
 
     /// Adds a row at the integrator's last accepted state when the rows end before it
@@ -237,12 +237,20 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
     /// [`fail`](Self::fail) with the rows as recorded (the last one already the state
     /// the run stops at), the work of `stepper`'s steps counted.
     fn failed(&mut self, stepper: Option<&Stepper>, mut kind: SimErrorKind) -> SimError {
-        if let SimErrorKind::NewtonFailed { constraints, .. }
-        | SimErrorKind::Singular { constraints, .. } = &mut kind
-        {
-            if constraints.is_empty() {
-                *constraints = self.nearly_dependent();
+        match &mut kind {
+            SimErrorKind::NewtonFailed { constraints, .. }
+            | SimErrorKind::Singular { constraints, .. }
+                if constraints.is_empty() =>
+            {
+                *constraints = self.nearly_dependent(&NEAR_SINGULAR);
             }
+            // A step size driven to round-off where C_q is clearly near-singular (the
+            // first of NEAR_SINGULAR only: the failure itself says nothing of rank) is
+            // the accelerations growing without bound at a lock.
+            SimErrorKind::StepSizeTooSmall {
+                nearly_dependent, ..
+            } => *nearly_dependent = self.nearly_dependent(&NEAR_SINGULAR[..1]),
+            _ => {}
         }
         SimError {
             kind,

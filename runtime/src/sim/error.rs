@@ -187,12 +187,21 @@ pub enum SimErrorKind {
         nearly_dependent: Vec<&'static str>,
     },
     /// The step size fell below what the precision of `t` resolves.
-    #[error("step size {h:e} too small at t = {t:?}")]
+    #[error(
+        "step size {h:e} too small at t = {t:?}{}",
+        lock_clause(nearly_dependent)
+    )]
     StepSizeTooSmall {
         /// Time of the last accepted state.
         t: f64,
         /// Step size.
         h: f64,
+        /// The holonomic constraints that take part in a near dependence of $C_q$ at
+        /// the last recorded state (a singular value below $10^{-3}$ of the largest,
+        /// rows at unit length): a lock or singular configuration where the
+        /// accelerations grow without bound. Empty when $C_q$ is well conditioned
+        /// there (stiffness, a discontinuity).
+        nearly_dependent: Vec<&'static str>,
     },
     /// More step attempts than allowed.
     #[error("more than {steps} step attempts, at t = {t:?}")]
@@ -333,7 +342,11 @@ impl SimErrorKind {
     /// system that failed, see `System::take_failure`).
     pub(crate) fn from_ode(e: OdeError) -> Self {
         match e {
-            OdeError::StepSizeTooSmall { t, h } => Self::StepSizeTooSmall { t, h },
+            OdeError::StepSizeTooSmall { t, h } => Self::StepSizeTooSmall {
+                t,
+                h,
+                nearly_dependent: Vec::new(),
+            },
             OdeError::MaxStepsExceeded { t, steps } => Self::MaxSteps { t, steps },
             OdeError::NonFinite {
                 t,
@@ -368,6 +381,19 @@ fn singular_mass_cause(jacobian_ratio: f64, nearly: &[&str], coordinates: &[&str
 }
 
 /// `"{what} involved: [..]"`, or why none can be named.
+/// The clause of a step-size failure at a near-singular configuration.
+fn lock_clause(nearly_dependent: &[&str]) -> String {
+    if nearly_dependent.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ": the constraints {nearly_dependent:?} are nearly dependent there (a lock or \
+             singular configuration of the mechanism, where the accelerations grow without \
+             bound)"
+        )
+    }
+}
+
 fn involved(what: &str, names: &[&str], otherwise: &str) -> String {
     if names.is_empty() {
         format!("no {what} identified: {otherwise}")

@@ -485,4 +485,35 @@ fn a_lock_names_the_dependent_set_of_constraints() {
             formulation.name()
         );
     }
+    // Baumgarte's index-1 equations have no projection to fail: the accelerations grow
+    // without bound at the lock and the step size falls to round-off there, which the
+    // failure attributes to the same set.
+    let err = Simulation::new(&model)
+        .formulation(Formulation::Baumgarte {
+            alpha: 10.0,
+            beta: 10.0,
+        })
+        .run(0.2)
+        .unwrap_err();
+    let SimErrorKind::StepSizeTooSmall {
+        t,
+        nearly_dependent,
+        ..
+    } = &err.kind
+    else {
+        panic!("baumgarte: {err}");
+    };
+    let lock = ((0.3_f64 / 0.35).asin() - std::f64::consts::FRAC_PI_6) / 10.0;
+    assert!(
+        (t - lock).abs() < 1e-3,
+        "baumgarte: t = {t}, lock at {lock}"
+    );
+    let mut named = nearly_dependent.clone();
+    named.sort_unstable();
+    assert_eq!(
+        named,
+        ["driver", "guide_y", "pin_a_y", "pin_b_y", "pin_o_y"],
+        "baumgarte: {err}"
+    );
+    assert!(err.to_string().contains("nearly dependent there"), "{err}");
 }
