@@ -459,10 +459,11 @@ pub(crate) fn condition_with<M: Mechanism + ?Sized>(
     })
 }
 
-/// The holonomic constraints that take part in the near dependence of the rows of
-/// $C_q(q, t)$, for naming them in an error: the first of `ratios` below which some
-/// singular value $\sigma_k$ of $C_q$ (its rows scaled to unit length, so that the
-/// units of the constraints do not count) lies relative to the largest, the left
+/// The holonomic constraints among `rows` (the rows the analyses keep: constraints
+/// found redundant are reported as such, not here) that take part in the near
+/// dependence of those rows of $C_q(q, t)$, for naming them in an error: the first of
+/// `ratios` below which some singular value $\sigma_k$ of them (scaled to unit length,
+/// so that the units of the constraints do not count) lies relative to the largest, the left
 /// singular vectors $u_k$ of all such values, and the rows whose entries in them reach
 /// a tenth of their largest ($\sum_i u_{ik}\,\text{row}_i \approx 0$ is the dependent
 /// combination), most involved first. Empty when no ratio finds a dependence (or
@@ -477,17 +478,19 @@ pub(crate) fn dependent_constraints<M: Mechanism + ?Sized>(
     ws: &mut Workspace,
     t: f64,
     q: &[f64],
+    rows: &[usize],
     ratios: &[f64],
 ) -> Vec<&'static str> {
     let info = ws.info();
-    let (n, mh) = (info.nq(), info.nh());
+    let (n, mh) = (info.nq(), rows.len());
     if mh == 0 || ws.eval_jacobian(mech, t, q).is_err() {
         return Vec::new();
     }
-    let jacobian = &ws.jacobian[..mh * n];
-    let norms: Vec<f64> = (0..mh)
-        .map(|i| {
-            let row = &jacobian[i * n..(i + 1) * n];
+    let jacobian = &ws.jacobian;
+    let norms: Vec<f64> = rows
+        .iter()
+        .map(|&r| {
+            let row = &jacobian[r * n..(r + 1) * n];
             row.iter().map(|x| x * x).sum::<f64>().sqrt()
         })
         .collect();
@@ -497,7 +500,7 @@ pub(crate) fn dependent_constraints<M: Mechanism + ?Sized>(
     // A zero row is dependent by itself; the others are scaled to unit length.
     let a = faer::Mat::from_fn(mh, n, |i, j| {
         if norms[i] > 0.0 {
-            jacobian[i * n + j] / norms[i]
+            jacobian[rows[i] * n + j] / norms[i]
         } else {
             0.0
         }
@@ -518,11 +521,14 @@ pub(crate) fn dependent_constraints<M: Mechanism + ?Sized>(
             .map(|i| weak.iter().fold(0.0_f64, |w, &k| w.max(u[(i, k)].abs())))
             .collect();
         let top = weight.iter().fold(0.0_f64, |w, &x| w.max(x));
-        let mut rows: Vec<usize> = (0..mh)
+        let mut named: Vec<usize> = (0..mh)
             .filter(|&i| norms[i] == 0.0 || weight[i] >= 0.1 * top)
             .collect();
-        rows.sort_by(|&i, &k| weight[k].total_cmp(&weight[i]));
-        return rows.into_iter().map(|i| info.holonomic[i].name).collect();
+        named.sort_by(|&i, &k| weight[k].total_cmp(&weight[i]));
+        return named
+            .into_iter()
+            .map(|i| info.holonomic[rows[i]].name)
+            .collect();
     }
     Vec::new()
 }

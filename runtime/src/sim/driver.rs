@@ -146,8 +146,10 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         };
         p.invalidate();
         // The weakest dependence first: a stall near a fold (a slider at its reach)
-        // leaves a pivot ratio of a few 1e-3 at the last accepted state.
-        crate::partition::dependent_constraints(p.mech, &mut p.ws, t, &p.q, ratios)
+        // leaves a ratio of a few 1e-3 at the last accepted state. Among the rows kept:
+        // those found redundant are reported as such.
+        let rows = &p.rows[..p.rows_h];
+        crate::partition::dependent_constraints(p.mech, &mut p.ws, t, &p.q, rows, ratios)
     }
 
     /// Adds a row at the integrator's last accepted state when the rows end before it
