@@ -216,8 +216,8 @@ pub struct Dynamics {
     /// suggest a singular matrix. Allocated by [`Dynamics::new`] when there is no
     /// generated solve to try first, else at the first solve that needs them (most
     /// runs of a model with a generated solve never do: ten allocations fewer per run).
-    /// Boxed, like the sparse factors: a model takes one path, and the structure that
-    /// holds the others inline is moved whole while a run is set up.
+    /// These four are boxed: a model takes one path, and a structure holding the
+    /// others inline is moved whole while a run is set up.
     small: Option<Box<SmallLu>>,
     dense: Option<Box<DenseLu>>,
     sparse: Option<Box<SparseKkt>>,
