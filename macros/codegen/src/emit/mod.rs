@@ -10,6 +10,7 @@ mod corrected;
 mod data;
 pub mod expr;
 mod normal_map;
+pub mod nullspace;
 pub mod solve;
 
 use std::collections::HashSet;
@@ -417,6 +418,28 @@ fn doc_attr(docs: &str) -> TokenStream {
 }
 
 /// The replacement module for a successfully derived model.
+/// The entries of $C_q$ and $G$ at the declared initial state with the parameters'
+/// defaults (time 0), where every input is known at compile time: what the null-space
+/// solve chooses its partition by ([`nullspace`]).
+fn jacobian_at_start(g: &Graph, d: &Derived) -> Option<(Vec<f64>, Vec<f64>)> {
+    let (q0, _) = d.initial.as_ref()?;
+    let p = &d.param_defaults;
+    let param = |v: Var| match v {
+        Var::Param(i) => p.get(i as usize).copied().unwrap_or(f64::NAN),
+        Var::Time => 0.0,
+        _ => f64::NAN,
+    };
+    let q = crate::sym::transform::eval(g, q0, &param);
+    let env = |v: Var| match v {
+        Var::Q(i) => q.get(i as usize).copied().unwrap_or(f64::NAN),
+        other => param(other),
+    };
+    let exprs = |entries: &[Entry]| -> Vec<ExprId> { entries.iter().map(|e| e.expr).collect() };
+    let cq = crate::sym::transform::eval(g, &exprs(&d.cq), &env);
+    let gm = crate::sym::transform::eval(g, &exprs(&d.gm), &env);
+    Some((cq, gm))
+}
+
 pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     let names = ModelNames::new(model);
     let vis = &model.vis;
@@ -477,16 +500,20 @@ pub fn mechanism(model: &Model, d: &Derived, g: &Graph) -> TokenStream {
     }
     fns.extend(dynamics_terms(g, &names, d));
     fns.extend(corrected::dynamics_terms_corrected(g, &names, d));
+    let at_start = jacobian_at_start(g, d);
+    let at_start = at_start.as_ref().map(|(c, n)| (&c[..], &n[..]));
     fns.extend(solve::augmented_solve(
         g,
         model.coords.len(),
         (d.c.len(), d.gb.len()),
         (&d.mass, &d.cq, &d.gm),
+        at_start,
     ));
     fns.extend(solve::orthogonal_solve(
         model.coords.len(),
         (d.c.len(), d.gb.len()),
         (&d.cq, &d.gm),
+        at_start,
     ));
     fns.extend(solve::velocity_residuals(
         model.coords.len(),

@@ -34,6 +34,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use proc_macro2::{Literal, TokenStream};
 use quote::{quote, ToTokens};
 
+use super::nullspace::{self, Jacobian, MetricEntries};
 use crate::derive::Entry;
 use crate::sym::{ExprId, Graph, Node, Var};
 
@@ -362,7 +363,7 @@ impl Plan {
     /// every reciprocal `r` is positive and $l = w r$ holds in both blocks; `z` is
     /// $y r$ ($D^{-1} y$ up to that sign) and `s` the solution ($-\lambda$ in the
     /// multipliers).
-    pub fn emit(&self) -> TokenStream {
+    pub fn emit(&self, prefix: TokenStream) -> TokenStream {
         let n = self.n;
         let dim = self.order.len();
         let lit = Literal::usize_unsuffixed;
@@ -772,6 +773,7 @@ impl Plan {
                 #cq_cut
                 #g_cut
                 let x = &mut x[..#dl];
+                #prefix
                 #code
                 ::pfaff::__private::AugmentedSolve::Solved
             }
@@ -900,11 +902,58 @@ pub fn augmented_solve(
     n: usize,
     rows: (usize, usize),
     (mass, cq, gm): (&[Entry], &[Entry], &[Entry]),
+    values: Option<(&[f64], &[f64])>,
 ) -> TokenStream {
     let added = normalization_rows(g, mass, cq);
     match Plan::new(n, rows, (Metric::Mass(mass), cq, gm), &added) {
-        Some(plan) if plan.operations <= BUDGET && n > 0 => plan.emit(),
+        Some(plan) if plan.operations <= BUDGET && n > 0 => {
+            let entries = mass
+                .iter()
+                .enumerate()
+                .map(|(k, e)| {
+                    let k = Literal::usize_unsuffixed(k);
+                    ((e.row as usize, e.col as usize), quote!(mass[#k]))
+                })
+                .collect();
+            let prefix = partitioned(
+                n,
+                rows,
+                (cq, gm),
+                values,
+                &MetricEntries::Mass(entries),
+                plan.operations,
+            );
+            plan.emit(prefix)
+        }
         _ => TokenStream::new(),
+    }
+}
+
+/// The null-space solve to try first ([`nullspace`](super::nullspace)), when the
+/// pattern has a partition and its code is cheaper than the range-space code's
+/// `operations`; empty otherwise.
+fn partitioned(
+    n: usize,
+    rows: (usize, usize),
+    patterns: (&[Entry], &[Entry]),
+    values: Option<(&[f64], &[f64])>,
+    metric: &MetricEntries,
+    operations: usize,
+) -> TokenStream {
+    if rows.0 + rows.1 == 0 || rows.0 + rows.1 > n {
+        return TokenStream::new();
+    }
+    let jac = Jacobian::new(n, rows, patterns, values);
+    match jac.partition() {
+        Some(part) => {
+            let (code, ops) = nullspace::emit(&jac, &part, metric);
+            if ops < operations {
+                code
+            } else {
+                TokenStream::new()
+            }
+        }
+        None => TokenStream::new(),
     }
 }
 
@@ -923,13 +972,22 @@ pub fn orthogonal_solve(
     n: usize,
     rows: (usize, usize),
     (cq, gm): (&[Entry], &[Entry]),
+    values: Option<(&[f64], &[f64])>,
 ) -> TokenStream {
     if rows.0 + rows.1 == 0 {
         return TokenStream::new();
     }
     match Plan::new(n, rows, (Metric::Identity, cq, gm), &[]) {
         Some(plan) if plan.operations <= BUDGET && n > 0 => {
-            let mut fns = plan.emit();
+            let prefix = partitioned(
+                n,
+                rows,
+                (cq, gm),
+                values,
+                &MetricEntries::Identity,
+                plan.operations,
+            );
+            let mut fns = plan.emit(prefix);
             fns.extend(orthogonal_projection(n, rows, (cq, gm)));
             fns
         }
