@@ -555,11 +555,15 @@ pub trait Mechanism {
     /// entry and $[\ddot q; \lambda]$ on return, from the pattern values `mass`, `cq`
     /// and `g` (as written by [`dynamics_terms`](Self::dynamics_terms)).
     ///
-    /// The generator emits it, specialized to the model's patterns (a sparse
-    /// $LDL^\mathsf{T}$ with the fill and the elimination order computed at compile
-    /// time, coordinates first, then multipliers), when that pays; every pivot is
-    /// checked, and [`AugmentedSolve::Declined`] hands the system back to the general
-    /// path ([`Dynamics`](crate::Dynamics)). The default returns
+    /// The generator emits it, specialized to the model's patterns, when that pays: where
+    /// cheaper, first the null-space method on a partition of the coordinates chosen at
+    /// compile time (elimination of $J$ with fixed pivots, the reduced system
+    /// $N^\mathsf{T} M N$ of the size of the degrees of freedom), and the range-space
+    /// code (a sparse $LDL^\mathsf{T}$ with the fill and the elimination order computed at
+    /// compile time, coordinates first, then multipliers) where a pivot of the partition
+    /// falls below its threshold. Every pivot is checked, and
+    /// [`AugmentedSolve::Declined`] hands the system back to the general path
+    /// ([`Dynamics`](crate::Dynamics)). The default returns
     /// [`AugmentedSolve::Unavailable`]. Allocates nothing.
     fn augmented_solve(
         &self,

@@ -34,7 +34,9 @@
 //! partition is a well-conditioned one there; without values (a run-time datum in
 //! $J$, no declared initial state) by the pattern alone. At run time every pivot must
 //! reach [`PIVOT_THRESHOLD`] of the largest entry left in its row (threshold pivoting:
-//! bounded growth, and a $J_d$ not near singular relative to $J$), and every pivot of
+//! bounded growth) and of the largest entry the row had before elimination (a row
+//! that elimination nearly cancelled: $J_d$ near singular, as at a lock, where the
+//! range-space code and the general path decide), and every pivot of
 //! the reduced system [`PIVOT_RATIO`](super::solve::PIVOT_RATIO) of its diagonal entry;
 //! a failed check (a configuration where the partition degrades, a non-finite entry)
 //! leaves the block before anything is written, and the range-space code solves.
@@ -48,7 +50,8 @@ use super::solve::PIVOT_RATIO;
 use crate::derive::Entry;
 
 /// At run time, the smallest accepted ratio of a pivot of $J_d$ to the largest entry
-/// left in its row (over the dependent and independent columns not yet eliminated).
+/// left in its row (over the dependent and independent columns not yet eliminated) and
+/// to the largest of the row's own entries before elimination.
 pub const PIVOT_THRESHOLD: f64 = 1e-2;
 
 /// At compile time, the ratio to the largest entry of its row an entry must reach at
@@ -312,6 +315,7 @@ pub fn emit(jac: &Jacobian, part: &Partition, metric: &MetricEntries) -> (TokenS
                 .collect()
         })
         .collect();
+    let original = a.clone();
     let mut mass_cache: HashMap<(usize, usize), V> = HashMap::new();
     let mut mass = |code: &mut Code, i: usize, j: usize| -> V {
         match metric {
@@ -347,10 +351,25 @@ pub fn emit(jac: &Jacobian, part: &Partition, metric: &MetricEntries) -> (TokenS
     for (k, &(r, c)) in part.pivots.iter().enumerate() {
         let pivot = a[r].get(&c).cloned().unwrap_or(V::Zero);
         let p = pivot.code();
-        let others: Vec<TokenStream> = a[r]
+        // The entries left in the row, and the row's own entries where elimination
+        // changed them (a pivot that cancelled, a row that became nearly dependent on
+        // the earlier ones: the singular configurations, where J_d degrades while the
+        // entries left beside the pivot may be few or none).
+        let left: Vec<&V> = a[r]
             .iter()
             .filter(|(&j, v)| j != c && !col_done[j] && !v.is_zero())
-            .map(|(_, v)| {
+            .map(|(_, v)| v)
+            .collect();
+        let names = |v: &V| v.code().to_string();
+        let current: BTreeSet<String> = a[r].values().map(names).collect();
+        let others: Vec<TokenStream> = left
+            .into_iter()
+            .chain(
+                original[r]
+                    .values()
+                    .filter(|v| !current.contains(&names(v))),
+            )
+            .map(|v| {
                 let x = v.code();
                 quote!(#x.abs())
             })
