@@ -31,8 +31,9 @@
 //! **Which partition, and when it declines.** The pivots are chosen by Markowitz' rule
 //! (least fill) among the entries within [`CHOICE_THRESHOLD`] of the largest of their
 //! row at the initial state, eliminated numerically as they are chosen, so the
-//! partition is a well-conditioned one there; without values (a run-time datum in
-//! $J$, no declared initial state) by the pattern alone. At run time every pivot must
+//! partition is a well-conditioned one there. Without values (a run-time datum in
+//! $J$, no declared initial state) nothing is emitted: a partition chosen by the
+//! pattern alone is a guess (see `solve::partitioned`). At run time every pivot must
 //! reach [`PIVOT_THRESHOLD`] of the largest entry left in its row (threshold pivoting:
 //! bounded growth) and of the largest entry the row had before elimination (a row
 //! that elimination nearly cancelled: $J_d$ near singular, as at a lock, where the
