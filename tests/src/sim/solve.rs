@@ -242,6 +242,39 @@ fn a_massless_coordinate_is_solved_by_the_partition_or_the_general_path() {
     assert_eq!(generated, 10, "states the generated solve served");
 }
 
+/// The inputs of the generated solve at a seeded state near the start ([`states`]):
+/// the pattern values of $M$, $C_q$ and $G$ and the right-hand side $[Q; \gamma]$.
+struct SolveInputs {
+    mass: Vec<f64>,
+    cq: Vec<f64>,
+    g: Vec<f64>,
+    b: Vec<f64>,
+}
+
+fn solve_inputs(model: &dyn Mechanism, seed: u64) -> SolveInputs {
+    let info = model.info();
+    let (n, mh) = (info.nq(), info.nh());
+    let (q, qd) = states(model, 1, seed).remove(0);
+    // [M, Q, C_q, γ_h, G, γ_nh] as one call writes them.
+    let all = terms(model, 0.3, &q, &qd, false);
+    let (lm, lc, lg) = (
+        info.mass_pattern.len(),
+        info.holonomic_pattern.len(),
+        info.nonholonomic_pattern.len(),
+    );
+    let (mass, rest) = all.split_at(lm);
+    let (forces, rest) = rest.split_at(n);
+    let (cq, rest) = rest.split_at(lc);
+    let (gh, rest) = rest.split_at(mh);
+    let (g, gnh) = rest.split_at(lg);
+    SolveInputs {
+        mass: mass.to_vec(),
+        cq: cq.to_vec(),
+        g: g.to_vec(),
+        b: [forces, gh, gnh].concat(),
+    }
+}
+
 /// The built-in models but those with redundant constraints (Bricard's linkage, the
 /// parallelogram), whose augmented system the general path solves.
 fn generated_solve_models() -> impl Iterator<Item = &'static pfaff_models::Entry> {
@@ -627,22 +660,7 @@ fn a_non_finite_input_never_gives_a_finite_generated_solution() {
         let model = (entry.make)();
         let model = model.as_ref();
         let info = model.info();
-        let (n, mh) = (info.nq(), info.nh());
-        let (q, qd) = states(model, 1, 31).remove(0);
-        // [M, Q, C_q, γ_h, G, γ_nh] as one call writes them.
-        let all = terms(model, 0.3, &q, &qd, false);
-        let (lm, lc, lg) = (
-            info.mass_pattern.len(),
-            info.holonomic_pattern.len(),
-            info.nonholonomic_pattern.len(),
-        );
-        let (mass, rest) = all.split_at(lm);
-        let (forces, rest) = rest.split_at(n);
-        let (cq, rest) = rest.split_at(lc);
-        let (gh, rest) = rest.split_at(mh);
-        let (g, gnh) = rest.split_at(lg);
-        let (mass, cq, g) = (mass.to_vec(), cq.to_vec(), g.to_vec());
-        let b = [forces, gh, gnh].concat();
+        let SolveInputs { mass, cq, g, b } = solve_inputs(model, 31);
         let mut x = b.clone();
         match model.augmented_solve(&mass, &cq, &g, &mut x) {
             AugmentedSolve::Unavailable => continue,
@@ -1263,8 +1281,9 @@ fn augmented_residual(
 /// which unchecked would grow the elimination by 1e9): wherever the solve solves, the
 /// solution meets the augmented system to 1e-7 of its terms (backward error; the
 /// range-space code's own pivot test, 1e-8 of the starting diagonal, admits growth to
-/// 1e8, and slider_crank_bodies reaches 7e-10), and on the unmodified systems to 1e-10. Checked to fail with the threshold set
-/// to 0 (pendulum, its one entry of $J$ in the chosen column made small: 8e-3).
+/// 1e8, and slider_crank_bodies reaches 7e-10), and on the unmodified systems to
+/// 1e-10. Checked to fail with the threshold set to 0 (pendulum, its one entry of $J$
+/// in the chosen column made small: 8e-3).
 #[test]
 fn a_degraded_partition_hands_the_solve_to_the_range_space_code() {
     let mut solved = 0;
@@ -1272,43 +1291,31 @@ fn a_degraded_partition_hands_the_solve_to_the_range_space_code() {
         let model = (entry.make)();
         let model = model.as_ref();
         let info = model.info();
-        let (n, mh) = (info.nq(), info.nh());
-        let (q, qd) = states(model, 1, 43).remove(0);
-        let all = terms(model, 0.3, &q, &qd, false);
-        let (lm, lc, lg) = (
-            info.mass_pattern.len(),
-            info.holonomic_pattern.len(),
-            info.nonholonomic_pattern.len(),
-        );
-        let (mass, rest) = all.split_at(lm);
-        let (forces, rest) = rest.split_at(n);
-        let (cq, rest) = rest.split_at(lc);
-        let (gh, rest) = rest.split_at(mh);
-        let (g, gnh) = rest.split_at(lg);
-        let b = [forces, gh, gnh].concat();
+        let SolveInputs { mass, cq, g, b } = solve_inputs(model, 43);
+        let (lc, lg) = (cq.len(), g.len());
         let mut x = b.clone();
-        if model.augmented_solve(mass, cq, g, &mut x) == AugmentedSolve::Unavailable {
+        if model.augmented_solve(&mass, &cq, &g, &mut x) == AugmentedSolve::Unavailable {
             continue;
         }
-        let e = augmented_residual(info, mass, cq, g, &b, &x);
+        let e = augmented_residual(info, &mass, &cq, &g, &b, &x);
         assert!(
             e <= 1e-10,
             "{}: residual {e:.1e} at a regular state",
             info.name
         );
         for k in 0..lc + lg {
-            let (mut cq, mut g) = (cq.to_vec(), g.to_vec());
+            let (mut cq, mut g) = (cq.clone(), g.clone());
             if k < lc {
                 cq[k] *= 1e-9;
             } else {
                 g[k - lc] *= 1e-9;
             }
             let mut x = b.clone();
-            if model.augmented_solve(mass, &cq, &g, &mut x) != AugmentedSolve::Solved {
+            if model.augmented_solve(&mass, &cq, &g, &mut x) != AugmentedSolve::Solved {
                 continue;
             }
             solved += 1;
-            let e = augmented_residual(info, mass, &cq, &g, &b, &x);
+            let e = augmented_residual(info, &mass, &cq, &g, &b, &x);
             assert!(
                 e <= 1e-7,
                 "{}: residual {e:.1e} with entry {k} of J made small",
