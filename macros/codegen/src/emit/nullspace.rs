@@ -38,7 +38,7 @@
 //! bounded growth) and of the largest entry the row had before elimination (a row
 //! that elimination nearly cancelled: $J_d$ near singular, as at a lock, where the
 //! range-space code and the general path decide), and every pivot of
-//! the reduced system [`PIVOT_RATIO`](super::solve::PIVOT_RATIO) of its diagonal entry;
+//! the reduced system [`PIVOT_RATIO`] of its diagonal entry;
 //! a failed check (a configuration where the partition degrades, a non-finite entry)
 //! leaves the block before anything is written, and the range-space code solves.
 
