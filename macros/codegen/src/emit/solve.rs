@@ -944,9 +944,8 @@ fn partitioned(
         return TokenStream::new();
     }
     let jac = Jacobian::new(n, rows, patterns, values);
-    // Without values the pattern alone would pick the pivots, and a partition chosen
-    // blind declined at its first pivots on flexible_crank (J from run-time data): the
-    // block's checks cost 3 % there and served nothing.
+    // Without values the pattern alone would pick the pivots: a guess, whose checks
+    // every evaluation would pay where it declines.
     if jac.values.is_none() {
         return TokenStream::new();
     }
