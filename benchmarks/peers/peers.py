@@ -109,13 +109,28 @@ MODELS = {
 NAMES = {"pendulum": mo.PENDULUM_NAMES, "andrews": mo.ANDREWS_NAMES, "car_axis": mo.CAR_AXIS_NAMES}
 
 
+MIN_TIME = 0.2
+"""Seconds of repetitions a short run is timed over at least (`--min-time`)."""
+MAX_REPEAT = 1000
+
+
+def repetitions(first, repeat, budget):
+    """How many times to time a run whose first call took `first` seconds: once when
+    it took more than `budget`; else `repeat` times, and more for a short run, until
+    the repetitions add up to `MIN_TIME` (at most `MAX_REPEAT`). On a shared machine a
+    sub-millisecond run is disturbed by a slice of another process often enough that
+    five repetitions do not find its undisturbed time; the same rule holds for every
+    tool."""
+    if first > budget:
+        return 1
+    return max(repeat, min(MAX_REPEAT, math.ceil(MIN_TIME / max(first, 1e-9))))
+
+
 def best_of(run, repeat, budget):
-    """Calls `run()` (which returns (result, seconds)) up to `repeat` times, fewer when
-    the first call took more than `budget` seconds; returns the last result and the
-    best time."""
+    """Calls `run()` (which returns (result, seconds)) as often as `repetitions` says;
+    returns the last result and the best time."""
     result, best = run()
-    count = 1 if best > budget else repeat
-    for _ in range(count - 1):
+    for _ in range(repetitions(best, repeat, budget) - 1):
         result, seconds = run()
         best = min(best, seconds)
     return result, best
@@ -149,7 +164,8 @@ def pfaff_rows(pfaff, model, tol, repeat, budget):
         first = pfaff_run(pfaff, model, formulation, integrator, tol, 1)
         err, evals, wall, fail = first
         if first[2] <= budget and fail is None:
-            err, evals, wall, fail = pfaff_run(pfaff, model, formulation, integrator, tol, repeat)
+            count = repetitions(first[2], repeat, budget)
+            err, evals, wall, fail = pfaff_run(pfaff, model, formulation, integrator, tol, count)
         rows.append(row(model, f"pfaff {formulation}+{integrator}", tol, err, evals, min(wall, first[2]), fail))
     return rows
 
@@ -349,6 +365,24 @@ def rhs_table(pfaff, model, compiled, ctypes_rhs, rows, tol):
 # --------------------------------------------------------------------------------------
 
 
+def best_rows(kept, new):
+    """The rows of one more round merged into those kept: each (tool, tolerance) keeps
+    its best wall time over the rounds (its error and evaluations are the same in every
+    round). The rounds spread each entry's repetitions over the whole run, so a slow
+    spell of the machine (seconds of a shared core running slower) reaches one round of
+    an entry, not all of its repetitions."""
+    if not kept:
+        return new
+    by_key = {(r["tool"], r["tol"], r.get("extra", False)): r for r in new}
+    merged = []
+    for r in kept:
+        other = by_key.get((r["tool"], r["tol"], r.get("extra", False)))
+        if other is not None and r["failure"] is None and other["failure"] is None:
+            r = {**r, "wall": min(r["wall"], other["wall"])}
+        merged.append(r)
+    return merged
+
+
 def row(model, tool, tol, error, evals, wall, failure, extra=False):
     """One run; `extra`: a pfaff run at a tolerance the peers were not run at (a
     candidate of the equal-accuracy comparison, listed in its own table)."""
@@ -474,7 +508,27 @@ def render_rhs(tables):
     return "\n".join(lines)
 
 
-def machine(pfaff, load_start):
+def cpu_times():
+    """The machine's CPU times since boot (`/proc/stat`: user, nice, system, idle,
+    iowait, irq, softirq, steal), or None where there is no such file."""
+    try:
+        with open("/proc/stat", encoding="utf-8") as f:
+            return [int(x) for x in f.readline().split()[1:9]]
+    except (OSError, ValueError):
+        return None
+
+
+def stolen(start):
+    """The share of the CPU time since `start` (`cpu_times()`) that the hypervisor gave
+    to other guests, or None."""
+    end = cpu_times()
+    if start is None or end is None or len(end) < 8:
+        return None
+    delta = [b - a for a, b in zip(start, end)]
+    return delta[7] / max(1, sum(delta))
+
+
+def machine(pfaff, load_start, cpu_start):
     cpu = platform.processor() or "?"
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
@@ -492,10 +546,12 @@ def machine(pfaff, load_start):
 
     commit = tool_version(["git", "-C", HERE, "log", "-1", "--format=%h %s"])
     load = ", ".join(f"{x[0]:.1f}" for x in (load_start, os.getloadavg()))
+    steal = stolen(cpu_start)
+    steal = "" if steal is None else f"; CPU time stolen by the hypervisor during the run {100 * steal:.1f} %"
     return "\n".join([
         f"- date: {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')}",
         f"- CPU: {cpu}, {os.cpu_count()} logical cores; {platform.system()} {platform.release()}; "
-        f"load average (1 min) at the start and at the end {load} (a load above the number of cores means other work shared the machine)",
+        f"load average (1 min) at the start and at the end {load} (a load above the number of cores means other work shared the machine){steal}",
         f"- pfaff: {tool_version([pfaff, '--version'])}, commit {commit}; {tool_version(['rustc', '--version'])}",
         f"- Python {platform.python_version()}, NumPy {np.__version__}, SciPy {scipy.__version__}, "
         f"CasADi {casadi.__version__} (SUNDIALS plugins of its wheel); {tool_version(['gcc', '--version'])}, flags {' '.join(CFLAGS)}",
@@ -503,6 +559,7 @@ def machine(pfaff, load_start):
 
 
 def main():
+    global MIN_TIME
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pfaff", required=True, help="path of the release `pfaff` binary")
     parser.add_argument("--models", default="pendulum,andrews,car_axis")
@@ -513,6 +570,10 @@ def main():
                              "2 times 10^-k, from 1e-2 to 1e-13), as candidates of the equal-accuracy "
                              "comparison")  # fmt: skip
     parser.add_argument("--repeat", type=int, default=5, help="timed repetitions (best is kept)")
+    parser.add_argument("--rounds", type=int, default=3,
+                        help="the whole table is measured this many times; each entry keeps its best")  # fmt: skip
+    parser.add_argument("--min-time", type=float, default=MIN_TIME,
+                        help="a short run is repeated until its repetitions add up to this many seconds")  # fmt: skip
     parser.add_argument("--budget", type=float, default=2.0,
                         help="a run longer than this many seconds is timed once")  # fmt: skip
     parser.add_argument("--rhs-tol", type=float, default=1e-8, help="tolerance of the in-run right-hand-side costs")
@@ -520,7 +581,8 @@ def main():
                         help="andrews' reference: the test set's values, or a converged pfaff run")  # fmt: skip
     parser.add_argument("--output", help="also write the report (Markdown) to this file")
     args = parser.parse_args()
-    load_start = os.getloadavg()
+    MIN_TIME = args.min_time
+    load_start, cpu_start = os.getloadavg(), cpu_times()
 
     import casadi as ca
 
@@ -552,16 +614,19 @@ def main():
         print(f"{name}: generated C of M, Q, J, gamma in {compiled.operations} operations, then LDL^T; "
               f"NumPy and C agree to {gap:.1e}", file=sys.stderr)  # fmt: skip
         model_rows = []
-        for tol in tols:
-            print(f"{name}: rtol = atol = {tol:.0e}", file=sys.stderr)
-            model_rows += pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget)
-            model_rows += scipy_rows(model, ctypes_rhs, tol, args.repeat, args.budget)
-            model_rows += sundials_rows(ca, model, compiled, tol, args.repeat, args.budget)
         extra = [float(t) for t in args.pfaff_tols.split(",") if float(t) not in tols]
-        for tol in extra:
-            print(f"{name}: pfaff at rtol = atol = {tol:.0e}", file=sys.stderr)
-            for r in pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget):
-                model_rows.append({**r, "extra": True})
+        for round_ in range(1, args.rounds + 1):
+            rows_now = []
+            for tol in tols:
+                print(f"{name}: round {round_}/{args.rounds}, rtol = atol = {tol:.0e}", file=sys.stderr)
+                rows_now += pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget)
+                rows_now += scipy_rows(model, ctypes_rhs, tol, args.repeat, args.budget)
+                rows_now += sundials_rows(ca, model, compiled, tol, args.repeat, args.budget)
+            for tol in extra:
+                print(f"{name}: round {round_}/{args.rounds}, pfaff at rtol = atol = {tol:.0e}", file=sys.stderr)
+                for r in pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget):
+                    rows_now.append({**r, "extra": True})
+            model_rows = best_rows(model_rows, rows_now)
         near = min(tols, key=lambda t: abs(math.log10(t / args.rhs_tol)))
         rhs[name] = rhs_table(args.pfaff, model, compiled, ctypes_rhs, model_rows, near)
         rows += model_rows
@@ -571,10 +636,11 @@ def main():
     )
     report = "\n\n".join([
         "# pfaff and its peers",
-        machine(args.pfaff, load_start),
+        machine(args.pfaff, load_start, cpu_start),
         f"Final position error (largest absolute error of the coordinates at the end: {spans}; "
         "pendulum against its closed form, andrews and car_axis against the test-set references), "
-        "right-hand-side evaluations and wall time (best of several runs). "
+        "right-hand-side evaluations and wall time (the best of at least `--repeat` runs, and of as many as "
+        f"take {MIN_TIME:g} s together for a short run, in each of {args.rounds} rounds over the whole table). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
         "with the fastest pfaff run, any method and tolerance (this table's and those of the table "
         "between the decades below), that is at least as accurate: whose error, and that of the same pfaff method at every "
