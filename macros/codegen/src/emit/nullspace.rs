@@ -282,9 +282,26 @@ pub enum MetricEntries {
     Identity,
 }
 
-/// The statements of the null-space solve (a labelled block that returns `Solved` or
-/// breaks out to the range-space code) and their operation count.
-pub fn emit(jac: &Jacobian, part: &Partition, metric: &MetricEntries) -> (TokenStream, usize) {
+/// What the null-space block computes and how it ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// The whole solution, $\ddot q$ (or $\Delta$) and the multipliers, then
+    /// `return Solved` (the block at the top of `augmented_solve`, `orthogonal_solve`).
+    Solve,
+    /// The coordinates' part of the solution alone, written to `x[..n]`, then
+    /// `break 'solve` (the block at the top of `orthogonal_projection`, which reads
+    /// $\Delta$ only: the multipliers' two triangular solves are left out).
+    Coordinates,
+}
+
+/// The statements of the null-space solve (a labelled block that ends as `ending`
+/// says or breaks out to the range-space code) and their operation count.
+pub fn emit(
+    jac: &Jacobian,
+    part: &Partition,
+    metric: &MetricEntries,
+    ending: Ending,
+) -> (TokenStream, usize) {
     let n = jac.n;
     let m = jac.rows.len();
     let mut code = Code::default();
@@ -581,6 +598,22 @@ pub fn emit(jac: &Jacobian, part: &Partition, metric: &MetricEntries) -> (TokenS
         }
         qdd[c] = code.sum(&terms);
     }
+    let mut out = TokenStream::new();
+    for (i, v) in qdd.iter().enumerate() {
+        let (k, v) = (lit(i), v.code());
+        out.extend(quote!(x[#k] = #v;));
+    }
+    if ending == Ending::Coordinates {
+        let stmts = code.stmts;
+        let block = quote! {
+            'partitioned: {
+                #stmts
+                #out
+                break 'solve;
+            }
+        };
+        return (block, code.ops);
+    }
     // The multipliers: J_dᵀ λ = (Q - M q̈)_d = (Q - M p̃ - M N a)_d, by Uᵀ z = s, Lᵀ y = z
     // over positions.
     let s: Vec<V> = part
@@ -616,11 +649,6 @@ pub fn emit(jac: &Jacobian, part: &Partition, metric: &MetricEntries) -> (TokenS
             }
         }
         lambda_pos[k] = code.sum(&terms);
-    }
-    let mut out = TokenStream::new();
-    for (i, v) in qdd.iter().enumerate() {
-        let (k, v) = (lit(i), v.code());
-        out.extend(quote!(x[#k] = #v;));
     }
     for (k, &(r, _)) in part.pivots.iter().enumerate() {
         let (idx, v) = (lit(n + r), lambda_pos[k].code());

@@ -34,7 +34,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use proc_macro2::{Literal, TokenStream};
 use quote::{quote, ToTokens};
 
-use super::nullspace::{self, Jacobian, MetricEntries};
+use super::nullspace::{self, Ending, Jacobian, MetricEntries};
 use crate::derive::Entry;
 use crate::sym::{ExprId, Graph, Node, Var};
 
@@ -915,14 +915,16 @@ pub fn augmented_solve(
                     ((e.row as usize, e.col as usize), quote!(mass[#k]))
                 })
                 .collect();
-            let prefix = partitioned(
+            let [prefix] = <[TokenStream; 1]>::try_from(partitioned(
                 n,
                 rows,
                 (cq, gm),
                 values,
                 &MetricEntries::Mass(entries),
                 plan.operations,
-            );
+                &[Ending::Solve],
+            ))
+            .expect("one block per ending");
             plan.emit(prefix)
         }
         _ => TokenStream::new(),
@@ -931,7 +933,8 @@ pub fn augmented_solve(
 
 /// The null-space solve to try first ([`nullspace`](super::nullspace)), when the
 /// pattern has a partition and its code is cheaper than the range-space code's
-/// `operations`; empty otherwise.
+/// `operations`: for each of `endings`, its block; empty otherwise (one empty stream
+/// per ending).
 fn partitioned(
     n: usize,
     rows: (usize, usize),
@@ -939,27 +942,34 @@ fn partitioned(
     values: Option<(&[f64], &[f64])>,
     metric: &MetricEntries,
     operations: usize,
-) -> TokenStream {
+    endings: &[Ending],
+) -> Vec<TokenStream> {
+    let none = || vec![TokenStream::new(); endings.len()];
     if rows.0 + rows.1 == 0 || rows.0 + rows.1 > n {
-        return TokenStream::new();
+        return none();
     }
     let jac = Jacobian::new(n, rows, patterns, values);
     // Without values the pattern alone would pick the pivots: a guess, whose checks
     // every evaluation would pay where it declines.
     if jac.values.is_none() {
-        return TokenStream::new();
+        return none();
     }
-    match jac.partition() {
-        Some(part) => {
-            let (code, ops) = nullspace::emit(&jac, &part, metric);
-            if ops < operations {
-                code
-            } else {
-                TokenStream::new()
-            }
-        }
-        None => TokenStream::new(),
+    let Some(part) = jac.partition() else {
+        return none();
+    };
+    // The whole solve decides, for every ending: the coordinates' block is the same
+    // code short of the multipliers.
+    let (solve, ops) = nullspace::emit(&jac, &part, metric, Ending::Solve);
+    if ops >= operations {
+        return none();
     }
+    endings
+        .iter()
+        .map(|&ending| match ending {
+            Ending::Solve => solve.clone(),
+            Ending::Coordinates => nullspace::emit(&jac, &part, metric, ending).0,
+        })
+        .collect()
 }
 
 /// The trait method `orthogonal_solve` for the patterns of $C_q$ and $G$: the
@@ -984,16 +994,18 @@ pub fn orthogonal_solve(
     }
     match Plan::new(n, rows, (Metric::Identity, cq, gm), &[]) {
         Some(plan) if plan.operations <= BUDGET && n > 0 => {
-            let prefix = partitioned(
+            let [prefix, coordinates] = <[TokenStream; 2]>::try_from(partitioned(
                 n,
                 rows,
                 (cq, gm),
                 values,
                 &MetricEntries::Identity,
                 plan.operations,
-            );
+                &[Ending::Solve, Ending::Coordinates],
+            ))
+            .expect("one block per ending");
             let mut fns = plan.emit(prefix);
-            fns.extend(orthogonal_projection(n, rows, (cq, gm)));
+            fns.extend(orthogonal_projection(n, rows, (cq, gm), coordinates));
             fns
         }
         _ => TokenStream::new(),
@@ -1005,10 +1017,17 @@ pub fn orthogonal_solve(
 /// then its entries in the pattern's order, left to right: the sums of the runtime's
 /// row-by-row loop, to the bit), the solve with $[0; -r]$ into a local array, and
 /// $\dot q \mathrel{+}= \Delta$ when every entry of $\Delta$ is finite.
+///
+/// Where `orthogonal_solve` opens with a null-space block, `partitioned` is the same
+/// block short of the multipliers, which the projection does not read (the two
+/// triangular solves with $J_d^\mathsf{T}$): $\Delta$ by the same operations, to the
+/// bit. Where it declines, `orthogonal_solve` solves (its own block declines there
+/// too, and its range-space code serves).
 fn orthogonal_projection(
     n: usize,
     (mh, mnh): (usize, usize),
     (cq, gm): (&[Entry], &[Entry]),
+    partitioned: TokenStream,
 ) -> TokenStream {
     let dim = n + mh + mnh;
     let lit = Literal::usize_unsuffixed;
@@ -1023,6 +1042,22 @@ fn orthogonal_projection(
         cuts,
     } = residual_inputs((mh, mnh), (cq, gm));
     let (n_lit, dim_lit) = (lit(n), lit(dim));
+    let general = quote! {
+        match self.orthogonal_solve(cq, g, &mut x) {
+            ::pfaff::__private::AugmentedSolve::Solved => {}
+            other => return other,
+        }
+    };
+    let solve = if partitioned.is_empty() {
+        general
+    } else {
+        quote! {
+            'solve: {
+                #partitioned
+                #general
+            }
+        }
+    };
     quote! {
         fn orthogonal_projection(
             &self,
@@ -1036,10 +1071,7 @@ fn orthogonal_projection(
             let qd = &mut qd[..#n_lit];
             let mut x = [0.0_f64; #dim_lit];
             #rows
-            match self.orthogonal_solve(cq, g, &mut x) {
-                ::pfaff::__private::AugmentedSolve::Solved => {}
-                other => return other,
-            }
+            #solve
             let delta = &x[..#n_lit];
             if !delta.iter().all(|d| d.is_finite()) {
                 return ::pfaff::__private::AugmentedSolve::Declined;
