@@ -915,7 +915,7 @@ pub fn augmented_solve(
                     ((e.row as usize, e.col as usize), quote!(mass[#k]))
                 })
                 .collect();
-            let [prefix] = <[TokenStream; 1]>::try_from(partitioned(
+            let mut blocks = partitioned(
                 n,
                 rows,
                 (cq, gm),
@@ -923,9 +923,9 @@ pub fn augmented_solve(
                 &MetricEntries::Mass(entries),
                 plan.operations,
                 &[Ending::Solve],
-            ))
-            .expect("one block per ending");
-            plan.emit(prefix)
+            )
+            .into_iter();
+            plan.emit(blocks.next().unwrap_or_default())
         }
         _ => TokenStream::new(),
     }
@@ -933,8 +933,8 @@ pub fn augmented_solve(
 
 /// The null-space solve to try first ([`nullspace`](super::nullspace)), when the
 /// pattern has a partition and its code is cheaper than the range-space code's
-/// `operations`: for each of `endings`, its block; empty otherwise (one empty stream
-/// per ending).
+/// `operations`: for each of `endings` in order, its block; empty otherwise (one empty
+/// stream per ending).
 fn partitioned(
     n: usize,
     rows: (usize, usize),
@@ -994,7 +994,7 @@ pub fn orthogonal_solve(
     }
     match Plan::new(n, rows, (Metric::Identity, cq, gm), &[]) {
         Some(plan) if plan.operations <= BUDGET && n > 0 => {
-            let [prefix, coordinates] = <[TokenStream; 2]>::try_from(partitioned(
+            let mut blocks = partitioned(
                 n,
                 rows,
                 (cq, gm),
@@ -1002,9 +1002,10 @@ pub fn orthogonal_solve(
                 &MetricEntries::Identity,
                 plan.operations,
                 &[Ending::Solve, Ending::Coordinates],
-            ))
-            .expect("one block per ending");
-            let mut fns = plan.emit(prefix);
+            )
+            .into_iter();
+            let mut fns = plan.emit(blocks.next().unwrap_or_default());
+            let coordinates = blocks.next().unwrap_or_default();
             fns.extend(orthogonal_projection(n, rows, (cq, gm), coordinates));
             fns
         }
