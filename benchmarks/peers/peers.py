@@ -215,6 +215,7 @@ class Compiled:
         self.library = os.path.join(BUILD, f"libpeers_{model.name}.so")
         subprocess.run(["gcc", *CFLAGS, "-fPIC", "-shared", self.source, "-o", self.library, "-lm"], check=True)
         self.symbol = ode.name()
+        self.parts, self.m, self.ode_fn = parts, m, ode
         self.ode = ca.external(ode.name(), self.library)
         self.dae = ca.external(dae.name(), self.library)
         self.operations = parts.n_instructions()
@@ -224,19 +225,108 @@ class Compiled:
         self.n = n
 
 
-class CtypesRhs:
-    """The compiled `NAME_ode` called through ctypes, as a Python callable for SciPy."""
+class Driver:
+    """The compiled peer (sundials.c): CVODES and IDAS called from C on CasADi's generated
+    C, linked statically against SUNDIALS (Debian's libsundials-dev, unpacked by run.sh).
+    The generated source defines `peer_ode` and `peer_ode_jac` (the index-1 ODE and its
+    exact Jacobian, dense), `peer_res` and `peer_res_jac` (the semi-explicit DAE
+    F(t, Y, Y') = [x' - [v; a]; A(x) z - b(x)], Y = [x; z], z = [a; lambda], and
+    dF/dY + cj dF/dY', dense)."""
 
-    def __init__(self, compiled):
-        lib = ctypes.CDLL(compiled.library)
-        self.fn = getattr(lib, compiled.symbol)
+    def __init__(self, ca, model, compiled, sundials):
+        n, m = compiled.n, compiled.m
+        t = ca.MX.sym("t")
+        y = ca.MX.sym("y", 2 * n)
+        ode = compiled.ode_fn(t, y)
+        peer_ode = ca.Function("peer_ode", [t, y], [ode])
+        peer_ode_jac = ca.Function("peer_ode_jac", [t, y], [ca.densify(ca.jacobian(ode, y))])
+        ts = ca.SX.sym("t")
+        big = ca.SX.sym("Y", 3 * n + m)
+        big_p = ca.SX.sym("Yp", 3 * n + m)
+        cj = ca.SX.sym("cj")
+        x, z, xp = big[: 2 * n], big[2 * n :], big_p[: 2 * n]
+        a, b = compiled.parts(ts, x)
+        res = ca.vertcat(xp - ca.vertcat(x[n:], z[:n]), ca.mtimes(a, z) - b)
+        peer_res = ca.Function("peer_res", [ts, big, big_p], [res])
+        jac = ca.densify(ca.jacobian(res, big) + cj * ca.jacobian(res, big_p))
+        peer_res_jac = ca.Function("peer_res_jac", [ts, big, big_p, cj], [jac])
+        source = f"peers_driver_{model.name}.c"
+        gen = ca.CodeGenerator(source)
+        for f in (peer_ode, peer_ode_jac, peer_res, peer_res_jac):
+            gen.add(f)
+        gen.generate(BUILD + os.sep)
+        self.exe = os.path.join(BUILD, f"sundials_{model.name}")
+        lib = os.path.join(sundials, "lib", "x86_64-linux-gnu")
+        if not os.path.isdir(lib):
+            lib = os.path.join(sundials, "lib")
+        static = [os.path.join(lib, f"libsundials_{name}.a") for name in (
+            "cvodes", "idas", "sunnonlinsolfixedpoint", "sunnonlinsolnewton", "sunlinsoldense",
+            "sunmatrixdense", "nvecserial", "generic")]  # fmt: skip
+        static = [f for f in static if os.path.exists(f)]
+        subprocess.run(
+            ["gcc", *CFLAGS, "-I", os.path.join(sundials, "include"), os.path.join(HERE, "sundials.c"),
+             os.path.join(BUILD, source), *static, "-lm", "-o", self.exe],
+            check=True,
+        )  # fmt: skip
+        self.nx, self.nz = 2 * n, n + m
+        self.z0 = compiled.z0
+        self.library = os.path.join(BUILD, f"libpeers_driver_{model.name}.so")
+        subprocess.run(["gcc", *CFLAGS, "-fPIC", "-shared", os.path.join(BUILD, source), "-o", self.library, "-lm"],
+                       check=True)  # fmt: skip
+        self.jacobian = CtypesRhs(compiled, self.library, "peer_ode_jac", (2 * n, 2 * n))
+
+    def run(self, method, model, tol, repeat):
+        """One process: the integration repeated `repeat` times; the report of the last."""
+        args = [self.exe, method, repr(tol), repr(tol), repr(model.t_end), str(repeat), str(self.nx), str(self.nz)]
+        args += [repr(float(v)) for v in model.y0]
+        if method == "idas":
+            args += [repr(float(v)) for v in self.z0]
+        out = subprocess.run(args, capture_output=True, text=True, check=True)
+        return json.loads(out.stdout)
+
+
+DRIVER_METHODS = [
+    ("C + CVODES adams (compiled)", "cvodes-adams"),
+    ("C + CVODES bdf (compiled)", "cvodes-bdf"),
+    ("C + IDAS (compiled)", "idas"),
+]
+
+
+def driver_rows(model, driver, tol, repeat, budget):
+    """The compiled peer at one tolerance: a first run finds the time of one integration,
+    then as many repetitions as `repetitions` says, in one process (as pfaff's --repeat)."""
+    rows = []
+    for label, method in DRIVER_METHODS:
+        first = driver.run(method, model, tol, 1)
+        if first["flag"] != 0:
+            rows.append(row(model, label, tol, None, 0, 0.0, first["failure"][:40]))
+            continue
+        report = first
+        count = repetitions(first["wall"], repeat, budget)
+        if count > 1:
+            report = driver.run(method, model, tol, count)
+        err = model.error(report["x"][: model.n])
+        rows.append(row(model, label, tol, err, report["rhs_evals"], min(first["wall"], report["wall"]), None))
+    return rows
+
+
+class CtypesRhs:
+    """A compiled function of (t, y) called through ctypes, as a Python callable for
+    SciPy (`y, t` as odeint passes them): `NAME_ode`, or with `library`/`symbol`/`shape`
+    another one with a dense output of that shape (the Jacobian `peer_ode_jac`)."""
+
+    def __init__(self, compiled, library=None, symbol=None, shape=None):
+        lib = ctypes.CDLL(library or compiled.library)
+        symbol = symbol or compiled.symbol
+        self.fn = getattr(lib, symbol)
         size = ctypes.c_longlong
         sizes = [size() for _ in range(4)]
-        getattr(lib, compiled.symbol + "_work")(*[ctypes.byref(s) for s in sizes])
+        getattr(lib, symbol + "_work")(*[ctypes.byref(s) for s in sizes])
         n_arg, n_res, n_iw, n_w = (max(1, s.value) for s in sizes)
+        self.shape = shape
         self.t = np.zeros(1)
         self.y = np.zeros(2 * compiled.n)
-        self.out = np.zeros(2 * compiled.n)
+        self.out = np.zeros(shape[0] * shape[1] if shape else 2 * compiled.n)
         dp = ctypes.POINTER(ctypes.c_double)
         self.arg = (dp * n_arg)(self.t.ctypes.data_as(dp), self.y.ctypes.data_as(dp))
         self.res = (dp * n_res)(self.out.ctypes.data_as(dp))
@@ -250,6 +340,8 @@ class CtypesRhs:
         self.t[0] = t
         self.y[:] = y
         self.fn(*self.args)
+        if self.shape:
+            return self.out.reshape(self.shape, order="F")  # CasADi's dense output is column-major
         return self.out.copy()
 
 
@@ -295,11 +387,12 @@ def sundials_rows(ca, model, compiled, tol, repeat, budget):
 # --------------------------------------------------------------------------------------
 
 
-def scipy_rows(model, compiled_rhs, tol, repeat, budget):
+def scipy_rows(model, compiled_rhs, jacobian, tol, repeat, budget, numpy=True):
+    """SciPy's runs; `numpy=False`: only odeint on the compiled right-hand side."""
     from scipy.integrate import odeint, solve_ivp
 
     rows = []
-    for method in ("DOP853", "LSODA", "Radau"):
+    for method in ("DOP853", "LSODA", "Radau") if numpy else ():
 
         def run(method=method):
             start = time.perf_counter()
@@ -310,15 +403,17 @@ def scipy_rows(model, compiled_rhs, tol, repeat, budget):
         fail = None if sol.success else sol.message[:40]
         rows.append(row(model, f"SciPy {method} + NumPy", tol, model.error(sol.y[: model.n, -1]), sol.nfev, wall, fail))
 
+    # LSODA given CasADi's exact Jacobian (`Dfun`), as a careful user sets it up: its
+    # switch to BDF then needs no finite differences.
     def run_c():
         start = time.perf_counter()
-        y, info = odeint(compiled_rhs, model.y0, [0.0, model.t_end], rtol=tol, atol=tol,
+        y, info = odeint(compiled_rhs, model.y0, [0.0, model.t_end], Dfun=jacobian, rtol=tol, atol=tol,
                          mxstep=10**7, full_output=True)  # fmt: skip
         return (y, info), time.perf_counter() - start
 
     (y, info), wall = best_of(run_c, repeat, budget)
     fail = None if info["message"].startswith("Integration successful") else info["message"][:40]
-    rows.append(row(model, "SciPy LSODA (odeint) + CasADi C", tol, model.error(y[-1, : model.n]), int(info["nfe"][-1]), wall, fail))
+    rows.append(row(model, "SciPy LSODA (odeint) + CasADi C + Jacobian", tol, model.error(y[-1, : model.n]), int(info["nfe"][-1]), wall, fail))
     return rows
 
 
@@ -404,14 +499,14 @@ def fmt_ratio(x):
 
 
 def envelope(rows):
-    """For each pfaff run, the largest error of its method (model, formulation and
-    integrator) at its tolerance and every tighter one: the accuracy the run can be
-    counted on for. A final error is one sample of the error's oscillation along the
-    run, and a loose run can land near the reference by a lucky phase (andrews,
-    projection + DOP853: 4.1e-6 at rtol 3e-3 but 5.9e-4 at 1e-4); such a run must not
-    stand in for an accurate one."""
+    """For each run, the largest error of its method (model and tool) at its tolerance
+    and every tighter one: the accuracy the run can be counted on for. A final error is
+    one sample of the error's oscillation along the run, and a loose run can land near
+    the reference by a lucky phase (andrews, projection + DOP853: 4.1e-6 at rtol 3e-3
+    but 5.9e-4 at 1e-4); such a run must not stand in for an accurate one. The same
+    rule holds for every tool."""
     for r in rows:
-        if r["tool"].startswith("pfaff") and r["error"] is not None:
+        if r["error"] is not None:
             tighter = [
                 p["error"] for p in rows
                 if (p["model"], p["tool"]) == (r["model"], r["tool"]) and p["tol"] <= r["tol"]
@@ -466,14 +561,62 @@ def render(rows):
 
 def render_extra(rows):
     lines = [
-        "| model | pfaff method | rtol = atol | error | rhs evals | wall [ms] |",
+        "| model | tool / method | rtol = atol | error | rhs evals | wall [ms] |",
         "|---|---|---:|---:|---:|---:|",
     ]
     for r in sorted((r for r in rows if r["extra"]), key=lambda r: (r["model"], r["tool"], -r["tol"])):
         wall = "—" if r["failure"] else f"{r['wall'] * 1e3:.3g}"
         error = f"failed: {r['failure']}" if r["failure"] else fmt_e(r["error"])
-        lines.append(f"| {r['model']} | {r['tool'].removeprefix('pfaff ')} | {r['tol']:.0e} | {error} | {r['evals']} | {wall} |")
+        lines.append(f"| {r['model']} | {r['tool']} | {r['tol']:.0e} | {error} | {r['evals']} | {wall} |")
     return "\n".join(lines)
+
+
+def fastest(rows, model, tool, target):
+    """The fastest run of `tool` on `model` (any tolerance) whose assured error (see
+    `envelope`) is at most `target`, or None."""
+    fit = [
+        r for r in rows
+        if r["model"] == model and r["tool"] == tool and r["failure"] is None
+        and r.get("assured") is not None and r["assured"] <= target
+    ]  # fmt: skip
+    return min(fit, key=lambda r: r["wall"]) if fit else None
+
+
+def render_targets(rows, targets):
+    """Work at equal accuracy, every tool alike: for each error target, each tool's
+    fastest run (any of its tolerances) whose assured error is within the target, as a
+    ratio to pfaff's default method and to pfaff's fastest method at the same target."""
+    out = []
+    for model in dict.fromkeys(r["model"] for r in rows):
+        tools = list(dict.fromkeys(r["tool"] for r in rows if r["model"] == model))
+        pfaff = [t for t in tools if t.startswith("pfaff")]
+        peers = [t for t in tools if not t.startswith("pfaff")]
+        lines = [
+            f"### {model}",
+            "",
+            "| error ≤ | pfaff default [ms] | pfaff fastest [ms] (method, rtol) | "
+            + " | ".join(peers) + " |",
+            "|---:|---:|---|" + "---:|" * len(peers),
+        ]
+        for target in targets:
+            default = fastest(rows, model, PFAFF_DEFAULT, target)
+            candidates = [f for f in (fastest(rows, model, t, target) for t in pfaff) if f is not None]
+            best = min(candidates, key=lambda r: r["wall"]) if candidates else None
+            cells = []
+            for peer in peers:
+                p = fastest(rows, model, peer, target)
+                if p is None:
+                    cells.append("—")
+                    continue
+                by_default = fmt_ratio(p["wall"] / default["wall"]) if default else "—"
+                by_best = fmt_ratio(p["wall"] / best["wall"]) if best else "—"
+                cells.append(f"{by_default} / {by_best}")
+            d = f"{default['wall'] * 1e3:.3g}" if default else "—"
+            b = (f"{best['wall'] * 1e3:.3g} ({best['tool'].removeprefix('pfaff ')}, {best['tol']:.0e})"
+                 if best else "—")  # fmt: skip
+            lines.append(f"| {target:.0e} | {d} | {b} | " + " | ".join(cells) + " |")
+        out.append("\n".join(lines))
+    return "\n\n".join(out)
 
 
 def render_equal(rows, tols):
@@ -579,9 +722,13 @@ def main():
                         help="a short run is repeated until its repetitions add up to this many seconds")  # fmt: skip
     parser.add_argument("--budget", type=float, default=2.0,
                         help="a run longer than this many seconds is timed once")  # fmt: skip
+    parser.add_argument("--targets", default=",".join(f"1e-{k}" for k in range(3, 13)),
+                        help="error targets of the table of work at equal accuracy")  # fmt: skip
     parser.add_argument("--rhs-tol", type=float, default=1e-8, help="tolerance of the in-run right-hand-side costs")
     parser.add_argument("--andrews-reference", choices=["testset", "converged"], default="testset",
                         help="andrews' reference: the test set's values, or a converged pfaff run")  # fmt: skip
+    parser.add_argument("--sundials", help="prefix of SUNDIALS' headers and static libraries (include/, lib/): "
+                        "builds the compiled peer (sundials.c); run.sh unpacks Debian's libsundials-dev there")
     parser.add_argument("--output", help="also write the report (Markdown) to this file")
     args = parser.parse_args()
     MIN_TIME = args.min_time
@@ -590,6 +737,7 @@ def main():
     import casadi as ca
 
     tols = [float(t) for t in args.tols.split(",")]
+    targets = [float(t) for t in args.targets.split(",")]
     notes = []
     if "andrews" in args.models.split(","):
         q_pfaff, q_scipy = converged_andrews(args.pfaff)
@@ -609,6 +757,8 @@ def main():
         model = MODELS[name]
         compiled = Compiled(ca, model)
         ctypes_rhs = CtypesRhs(compiled)
+        driver = Driver(ca, model, compiled, args.sundials) if args.sundials else None
+        jacobian = driver.jacobian if driver else None
         # the two right-hand sides agree before anything is timed
         y = model.y0 + np.linspace(0.01, 0.05, 2 * model.n)
         gap = np.max(np.abs(ctypes_rhs(y, 0.0) - model.numpy_rhs(0.0, y))) / np.max(np.abs(model.numpy_rhs(0.0, y)))
@@ -623,12 +773,20 @@ def main():
             for tol in tols:
                 print(f"{name}: round {round_}/{args.rounds}, rtol = atol = {tol:.0e}", file=sys.stderr)
                 rows_now += pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget)
-                rows_now += scipy_rows(model, ctypes_rhs, tol, args.repeat, args.budget)
+                rows_now += scipy_rows(model, ctypes_rhs, jacobian, tol, args.repeat, args.budget)
                 rows_now += sundials_rows(ca, model, compiled, tol, args.repeat, args.budget)
+                if driver:
+                    rows_now += driver_rows(model, driver, tol, args.repeat, args.budget)
             for tol in extra:
-                print(f"{name}: round {round_}/{args.rounds}, pfaff at rtol = atol = {tol:.0e}", file=sys.stderr)
-                for r in pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget):
-                    rows_now.append({**r, "extra": True})
+                # Between the decades: pfaff and the compiled peers (the C driver and
+                # odeint on the C right-hand side) get the same grid of tolerances.
+                print(f"{name}: round {round_}/{args.rounds}, rtol = atol = {tol:.0e} (between the decades)",
+                      file=sys.stderr)  # fmt: skip
+                between = pfaff_rows(args.pfaff, model, tol, args.repeat, args.budget)
+                between += scipy_rows(model, ctypes_rhs, jacobian, tol, args.repeat, args.budget, numpy=False)
+                if driver:
+                    between += driver_rows(model, driver, tol, args.repeat, args.budget)
+                rows_now += [{**r, "extra": True} for r in between]
             model_rows = best_rows(model_rows, rows_now)
         near = min(tols, key=lambda t: abs(math.log10(t / args.rhs_tol)))
         rhs[name] = rhs_table(args.pfaff, model, compiled, ctypes_rhs, model_rows, near)
@@ -641,7 +799,10 @@ def main():
         "# pfaff and its peers",
         machine(args.pfaff, load_start, cpu_start),
         f"Final position error (largest absolute error of the coordinates at the end: {spans}; "
-        "pendulum against its closed form, andrews and car_axis against the test-set references), "
+        "pendulum against its closed form, car_axis against the test-set reference, andrews against "
+        + ("pfaff's converged run (partitioning + DOP853 at rtol 1e-13)"
+           if args.andrews_reference == "converged" else "the test-set reference")
+        + "), "
         "right-hand-side evaluations and wall time (the best of at least `--repeat` runs, and of as many as "
         f"take {MIN_TIME:g} s together for a short run, in each of {args.rounds} rounds over the whole table). "
         f"Ratios are to `{PFAFF_DEFAULT}` at the same tolerance; the last column compares "
@@ -651,7 +812,16 @@ def main():
         "does not count).",
         *notes,
         render(rows),
-        "## At equal accuracy",
+        "## Work at equal accuracy",
+        "Every tool alike: for each error target, each tool's fastest run, among all its tolerances "
+        "(the decades, and the points between them for pfaff and the compiled peers), whose error, and "
+        "that of the same tool at every tighter tolerance, is within the target. A cell is the peer's wall "
+        f"time over that of `{PFAFF_DEFAULT}` / over that of pfaff's fastest method at the same target: "
+        "above 1 pfaff is faster; `—`: no run of the tool (or of pfaff) reaches the target. The rows "
+        "`C + CVODES …` and `C + IDAS` are the compiled peer (sundials.c): SUNDIALS called from C on "
+        "CasADi's generated C, no interpreter in between.",
+        render_targets(rows, targets),
+        "## At equal accuracy, by the peer's tolerance",
         "The last column of the table by tolerance: a peer's wall time over that of the fastest pfaff run "
         "(any method, any tolerance) at least as accurate; above 1 pfaff is faster, `—`: no pfaff run as accurate.",
         render_equal(rows, tols),
