@@ -349,7 +349,7 @@ struct Check<'a> {
 const INDEPENDENT: f64 = 10.0;
 
 /// Safety factor on the first-order bound of the acceleration residual of a row that
-/// is dependent only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): the
+/// is dependent only near a rank drop (docs/decisions/0036-through-a-rank-drop.md): the
 /// bound's rate of the rows is estimated from $\gamma$.
 const RANK_DROP_SAFETY: f64 = 4.0;
 
@@ -845,7 +845,7 @@ impl Split {
     ///
     /// The rows $D$ must meet $\ddot q$ to the relative `redundant_tolerance`, or, with
     /// the state's velocities, within the first-order bound of a row that is dependent
-    /// only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): with
+    /// only near a rank drop (docs/decisions/0036-through-a-rank-drop.md): with
     /// $T_d = X_d^\mathsf{T}$ the least-squares combination of the rows $R$ and
     /// $w_d = J_d - T_d J_R$ what the row adds to them,
     /// $|J_d\ddot q - \gamma_d| \le 2\lVert\dot w_d\rVert\,|v_d - T_d v_R| / \lVert w_d\rVert$,

@@ -9,7 +9,7 @@
 //! The mode count is a literal of the source: it fixes the generated code. The
 //! contractions of the slot's blocks with `q_f` and `q̇_f` are loops from 8 modes on
 //! (`macros/codegen/src/sched/runs.rs`), so the 64-mode body compiles (before, rustc failed
-//! with SIGSEGV after 12 minutes on this file; ARCHITECTURE.md, deformable bodies).
+//! with SIGSEGV after 12 minutes on this file; docs/decisions/0015-run-time-data-slots.md).
 //!
 //! `cargo bench -p pfaff-tests --bench flex_modes`
 

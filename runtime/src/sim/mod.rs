@@ -31,7 +31,7 @@
 //!   (another intersection of the normal space with the manifold), is a recoverable
 //!   failure: the integrator rejects the attempt and retries a quarter of the step.
 //!   The choice of this chart over a partition of the coordinates themselves, with the
-//!   measurements behind it, is explained in `ARCHITECTURE.md`.
+//!   measurements behind it, is in `docs/decisions/0021-partitioning-in-a-local-chart.md`.
 //! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
 //!   step $q$ is projected onto $C(q,t) = 0$ and $\dot q$ onto $J\dot q + [C_t; g] = 0$,
 //!   handed back with [`Integrator::set_state`](crate::ode::Integrator::set_state).
@@ -43,8 +43,7 @@
 //!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and
 //!   $\dot q \leftarrow \dot q - J^\mathsf{T}(JJ^\mathsf{T})^{-1}(J\dot q + [C_t; g])$,
 //!   dense in $m$. Either meets $C$ to the Newton tolerance and the velocity
-//!   constraints to round-off (`ARCHITECTURE.md`, "Decision: the projection in the
-//!   metric of the mass matrix").
+//!   constraints to round-off (`docs/decisions/0034-projection-in-the-mass-metric.md`).
 //! - [`Formulation::Baumgarte`]: index 1 on $y = [q; \dot q]$ with
 //!   $\gamma_h \leftarrow \gamma_h - 2\alpha(C_q\dot q + C_t) - \beta^2 C$ and
 //!   $\gamma_{nh} \leftarrow \gamma_{nh} - 2\alpha(G\dot q + g)$, so that the

@@ -94,7 +94,8 @@ fn partitioned_error_is_within_three_times_the_projected_one() {
 /// (and of the polish of accepted states) average at most 2 per evaluation of the
 /// right-hand side, with every adaptive explicit method. Radau5 runs the chart to
 /// round-off instead of to its tolerance (its Jacobian is made of differences of the
-/// right-hand side, see ARCHITECTURE.md), which costs about one update more: at most 3.
+/// right-hand side, see docs/decisions/0026-implicit-integrator-radau5.md), which costs
+/// about one update more: at most 3.
 #[test]
 fn andrews_takes_at_most_two_newton_updates_per_evaluation() {
     let model = andrews::Model::default();

@@ -240,7 +240,7 @@ fn partitioning_never_lands_on_the_mirror_branch() {
 /// projection), 11 per rejected attempt and 1 at the start ($f(t_0)$; the first step
 /// is given, so Hairer's `HINIT` does not run); the interpolant's three stages (14–16
 /// of `dop853.f`) only when the run has rows to interpolate, on the same steps
-/// (ARCHITECTURE.md, "dense output only where the run interpolates"). The first step,
+/// (docs/decisions/0023-dense-output-only-where-interpolated.md). The first step,
 /// a fifth of a period, is far too long for rtol 1e-8, so the run starts with
 /// rejections.
 #[test]

@@ -350,8 +350,8 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 }
                 // `Ċ = C_q q̇ + C_t` as the forward-mode rate of `C`, not the sum over
                 // the Jacobian's entries: the second rate then walks `C`'s DAG twice
-                // instead of differentiating every entry of `C_q` (ARCHITECTURE.md, "The
-                // body level").
+                // instead of differentiating every entry of `C_q`
+                // (docs/decisions/0009-gamma-as-second-forward-rate.md).
                 (diff::differentiate(g, h, Var::Time), diff::rate(g, h))
             }
         };

@@ -49,8 +49,9 @@
 //! The step-size rule departs from `STEP`, whose only increase is a doubling when
 //! $\text{erk}\,2^{k+1} \le \tfrac12\varepsilon$: at order 12 that keeps $h$ while erk
 //! ranges over a factor 8192, so $h$ froze at whatever value the start phase or the last
-//! failure left and the tolerance no longer set the error (ARCHITECTURE.md, "Decision:
-//! the Adams step size follows the tolerance"). Here $h$ follows the tolerance within a
+//! failure left and the tolerance no longer set the error
+//! (docs/decisions/0022-adams-step-size-follows-the-tolerance.md). Here $h$ follows the
+//! tolerance within a
 //! factor 32 of erk, and the safety factor 0.8 on $h$ (Hairer–Nørsett–Wanner I §II.4)
 //! keeps the global error of the test problems within about 3 × rtol at no cost at
 //! equal error.
