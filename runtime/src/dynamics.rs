@@ -1,4 +1,4 @@
-//! Accelerations and multipliers from the augmented system (math-spec §5, E31).
+//! Accelerations and multipliers from the augmented system (docs/theory.md §augmented, E31).
 //!
 //! Input: $(q, \dot q, t)$ and a [`Workspace`]. Output: $\ddot q$ and
 //! $\lambda = [\lambda_h; \lambda_{nh}]$ solving
@@ -6,7 +6,7 @@
 //!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix},\qquad J = \begin{bmatrix}C_q\\ G\end{bmatrix},
 //!   \quad \gamma = \begin{bmatrix}\gamma_h\\ \gamma_{nh}\end{bmatrix},$$
-//! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of math-spec §1).
+//! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of docs/theory.md §sign).
 //!
 //! **Paths.** The model's own solve ([`Mechanism::augmented_solve`]: a sparse
 //! $LDL^\mathsf{T}$ the generator specialized to the patterns of $M$ and $J$, every

@@ -1,4 +1,4 @@
-//! Generalized coordinate partitioning (math-spec §6, Algorithm P) and its condition
+//! Generalized coordinate partitioning (docs/theory.md §partitioning, Algorithm P) and its condition
 //! monitor.
 //!
 //! Input: a configuration $(q, t)$ (consistent or not) and the Jacobian

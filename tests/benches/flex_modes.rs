@@ -1,5 +1,5 @@
 //! Cost of a deformable body as its number of modes grows: the spin-up beam
-//! (benchmark-models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 32 clamped
+//! (docs/models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 32 clamped
 //! elements on a free hub, its invariants read from a beam data slot
 //! (`Beam { .., modes: n }`), for n = 4, 16 and 64 (issue 12). Timed:
 //! the generated `mass_matrix` and `forces` at a state with every coordinate and

@@ -6,12 +6,12 @@
 //! or a [`SimError`] that keeps the partial run.
 //!
 //! # Formulations
-//! With $J = [C_q; G]$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (math-spec §4–§5), the
+//! With $J = [C_q; G]$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (docs/theory.md §constraints), the
 //! accelerations come from the augmented system (E31)
 //! $$\begin{bmatrix}M & J^\mathsf{T}\\ J & 0\end{bmatrix}
 //!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix}.$$
-//! - [`Formulation::Partitioning`] (math-spec Algorithm D in local coordinates): the
+//! - [`Formulation::Partitioning`] (docs/theory.md Algorithm D in local coordinates): the
 //!   integrator carries $y = [q; \dot q]$, but the right-hand side is a function of
 //!   independent coordinates only. At each evaluation $y$ is moved onto the manifold
 //!   in the *chart* of the last accepted state $q_a$: the dependent coordinates are the
@@ -53,9 +53,9 @@
 //!   (critical damping, time constant 0.1 s; choose them a few times faster than the
 //!   motion of interest and slower than what the step size can resolve).
 //! - [`Formulation::Unconstrained`]: Lagrange's equations of the second kind in all
-//!   coordinates, $M\ddot q = Q$, without multipliers (math-spec (S2-22)): the
+//!   coordinates, $M\ddot q = Q$, without multipliers (docs/theory.md (S2-22)): the
 //!   constraints are not enforced. When the applied forces make the motion free
-//!   (math-spec §8) they hold by themselves, and the monitors measure how well. The
+//!   (docs/theory.md §redundant-coordinates) they hold by themselves, and the monitors measure how well. The
 //!   initial state is taken as given (prescriptions are written into it, nothing is
 //!   assembled); $M$ is factored densely.
 //!
@@ -152,11 +152,11 @@ pub fn min_step(t0: f64, t_end: f64) -> f64 {
 /// How the constrained equations become an ODE (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Formulation {
-    /// Coordinate partitioning, math-spec Algorithm D.
+    /// Coordinate partitioning, docs/theory.md Algorithm D.
     Partitioning,
     /// Index 1 with projection of positions and velocities after each step.
     Projection,
-    /// $M\ddot q = Q$ in all coordinates, without multipliers (math-spec (S2-22)).
+    /// $M\ddot q = Q$ in all coordinates, without multipliers (docs/theory.md (S2-22)).
     Unconstrained,
     /// Index 1 with Baumgarte stabilization.
     Baumgarte {
