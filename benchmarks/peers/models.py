@@ -2,7 +2,7 @@
 CasADi (symbolic, then generated C) for SUNDIALS, and the reference solutions.
 
 Both models are the ones of pfaff's `models/src/` with the same parameters, coordinates
-and initial state (benchmark-models.md). The index-1 form integrates y = [q; v] with
+and initial state (docs/models.md). The index-1 form integrates y = [q; v] with
 
     [M(q)  J(q)^T] [a     ]   [Q(q, v)    ]
     [J(q)  0     ] [lambda] = [gamma(q, v)],     y' = [v; a],
@@ -22,19 +22,19 @@ import numpy as np
 # --------------------------------------------------------------------------------------
 
 PENDULUM = {"m": 1.0, "l": 1.0, "g": 9.81}
-PENDULUM_PERIOD = 2.36784194757624  # 4 K(1/2) sqrt(l/g), benchmark-models.md
+PENDULUM_PERIOD = 2.36784194757624  # 4 K(1/2) sqrt(l/g), docs/models.md
 PENDULUM_T_END = 3.0 * PENDULUM_PERIOD  # the span of `pfaff simulate pendulum`
 PENDULUM_Q0 = np.array([1.0, 0.0])
 PENDULUM_NAMES = ["x", "y"]
 
 
 def pendulum_exact(t):
-    """Closed form of benchmark-models.md: theta from the downward vertical,
+    """Closed form of docs/models.md: theta from the downward vertical,
     sin(theta/2) = k sn(K - w0 t | m = 1/2), k = 1/sqrt(2), w0 = sqrt(g/l); the bob is
     at (l sin theta, -l cos theta). Returns the positions (x, y)."""
     from scipy.special import ellipj
 
-    K_HALF = 1.85407467730137191843  # K(1/2), benchmark-models.md
+    K_HALF = 1.85407467730137191843  # K(1/2), docs/models.md
     w0 = math.sqrt(PENDULUM["g"] / PENDULUM["l"])
     sn, _, _, _ = ellipj(K_HALF - w0 * t, 0.5)
     theta = 2.0 * math.asin(math.sqrt(0.5) * sn)
@@ -83,7 +83,7 @@ ANDREWS = dict(
 )  # fmt: skip
 ANDREWS_T_END = 0.03
 ANDREWS_NAMES = ["beta", "theta", "gamma", "phi", "delta", "omega", "epsilon"]
-# The consistent initial configuration of benchmark-models.md, at rest.
+# The consistent initial configuration of docs/models.md, at rest.
 ANDREWS_Q0 = np.array([
     -0.0617138900142764496358948458001,
     0.0,
@@ -109,7 +109,7 @@ ANDREWS_REFERENCE = np.array([
 
 def andrews_mass(q, cos, sin, p=ANDREWS):
     """The mass matrix entries (M11, M12, M22, M33, M44, M45, M55, M66, M67, M77) of
-    benchmark-models.md, with `cos`/`sin` of NumPy or CasADi."""
+    docs/models.md, with `cos`/`sin` of NumPy or CasADi."""
     m1, m2, m3, m4, m5, m6, m7 = (p[k] for k in ("m1", "m2", "m3", "m4", "m5", "m6", "m7"))
     i1, i2, i3, i4, i5, i6, i7 = (p[k] for k in ("i1", "i2", "i3", "i4", "i5", "i6", "i7"))
     rr, ra, da, e, ea, zt = p["rr"], p["ra"], p["da"], p["e"], p["ea"], p["zt"]
@@ -330,7 +330,7 @@ def car_axis_casadi(ca, t):
 
 def index1(ca, t, q, v, kinetic, applied, c):
     """The index-1 quantities from T, the applied forces and C(q, t), as pfaff's
-    generator derives them (math-spec section 4): M = T_vv, Q = Q_e + T_q - T_vq v - T_vt,
+    generator derives them (docs/theory.md §scope): M = T_vv, Q = Q_e + T_q - T_vq v - T_vt,
     J = C_q, gamma = -(J v)_q v - 2 J_t v - C_tt. Returns (M, Q, J, gamma)."""
     grad_v = ca.gradient(kinetic, v)
     mass = ca.jacobian(grad_v, v)

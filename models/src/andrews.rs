@@ -1,5 +1,5 @@
 //! Andrews' squeezing mechanism: seven rigid bodies in a plane, closed into two loops,
-//! driven by a motor torque against a stiff spring (benchmark-models.md; Hairer & Wanner,
+//! driven by a motor torque against a stiff spring (docs/models.md; Hairer & Wanner,
 //! Solving Ordinary Differential Equations II, §VII.7).
 
 /// Andrews' squeezing mechanism (Hairer & Wanner II, §VII.7): seven bodies, six

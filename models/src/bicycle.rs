@@ -1,7 +1,7 @@
 //! The Whipple bicycle benchmark of Meijaard, Papadopoulos, Ruina and Schwab (2007).
 
 /// Whipple bicycle (Meijaard, Papadopoulos, Ruina, Schwab 2007), built from its
-/// parameter table (benchmark-models.md), in the paper's axes: x forward, y right, z
+/// parameter table (docs/models.md), in the paper's axes: x forward, y right, z
 /// down, the ground the plane `z = 0`.
 ///
 /// Four rigid bodies: the rear wheel R, the rear frame with the rider B, the front

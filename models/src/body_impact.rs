@@ -1,7 +1,7 @@
-//! Impacts of free planar bodies: math-spec V13 (one body on a floor) and V14 (two
+//! Impacts of free planar bodies: docs/theory.md V13 (one body on a floor) and V14 (two
 //! bodies), with the input data of Nikravesh's examples 11.3 and 11.4.
 
-/// A free planar body striking a floor with a corner (math-spec V13).
+/// A free planar body striking a floor with a corner (docs/theory.md V13).
 ///
 /// Mass `m`, moment of inertia `j` about the centre of mass `(x, y)`, angle `phi`. The
 /// contact point sits at body coordinates `(1, 0)`; the floor is `y = 0`. The default
@@ -45,7 +45,7 @@ pub mod body_impact {
     }
 }
 
-/// Two free planar bodies colliding (math-spec V14): a disk and a rod.
+/// Two free planar bodies colliding (docs/theory.md V14): a disk and a rod.
 ///
 /// The disk (mass `m1`, inertia `j1`) touches the rod (mass `m2`, inertia `j2`) with its
 /// point at body `(0.1, 0)`; the rod's contact point is at body `(0, 0.25)`. The normal

@@ -1,7 +1,7 @@
 //! A ball bouncing on the ground: the impacts accumulate in finite time
-//! (benchmark-models.md, math-spec V17.4).
+//! (docs/models.md, docs/theory.md V17.4).
 
-/// Point mass dropped onto the ground, restitution `e` (benchmark-models.md).
+/// Point mass dropped onto the ground, restitution `e` (docs/models.md).
 ///
 /// The ball (mass `m`) starts at rest at height `h` and falls under gravity `g`; the
 /// contact `floor` is its height `y`. Each bounce returns it to `e²` times the height

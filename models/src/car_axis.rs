@@ -1,6 +1,6 @@
 //! The car axle of Rentrop, Roche and Steinebach (1989): two wheel points on a massless
 //! axle, one of them driven over a bumpy road, with rheonomic constraints
-//! (benchmark-models.md).
+//! (docs/models.md).
 
 /// Car axle (Rentrop, Roche, Steinebach 1989): rheonomic holonomic constraints.
 ///

@@ -1,6 +1,6 @@
-//! A uniform rod falling without rotation onto a smooth floor (benchmark-models.md).
+//! A uniform rod falling without rotation onto a smooth floor (docs/models.md).
 
-/// Uniform rod falling flat-on-an-angle onto a smooth floor (benchmark-models.md).
+/// Uniform rod falling flat-on-an-angle onto a smooth floor (docs/models.md).
 ///
 /// Rod of length `l` and mass `m`, centre of mass `(x, y)`, angle `phi` to the
 /// horizontal. It starts at `phi = angle` without rotation, its lower end `gap` above

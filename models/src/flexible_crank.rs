@@ -1,7 +1,7 @@
 //! Slider crank with an elastic connecting rod (Simeon; Test Set for IVP Solvers
 //! "crank"): a rigid crank, an elastic rod in the floating frame of reference and a rigid
 //! slider, in the plane, the crank driven at `omega`. `flexible_crank` uses the test
-//! set's precomputed invariants as benchmark-models.md prints them (π written 3.1415927,
+//! set's precomputed invariants as docs/models.md prints them (π written 3.1415927,
 //! the axial block of the modal mass 15 times the integral of its ansatz);
 //! `flexible_crank_shapes` integrates the same rod's shape functions at compile time.
 

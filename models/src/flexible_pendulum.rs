@@ -4,7 +4,7 @@
 /// Spatial flexible pendulum: a uniform steel bar (12 mm × 8 mm, 1 m) hanging from a
 /// ball joint at its end.
 ///
-/// The bar is 8 spatial beam elements (math-spec E20, §3.8) clamped to its floating
+/// The bar is 8 spatial beam elements (docs/theory.md E20, §beam-elements) clamped to its floating
 /// frame at the pivot (node 0) and reduced to its four lowest modes `p1 … p4` by
 /// `pfaff::flex` when the model is built (`SpatialBeam` data slot): bending in the stiff
 /// and the soft direction, twice each (clamped-free frequencies 42.0, 63.0, 263 and

@@ -1,6 +1,6 @@
-//! A torque-free spatial rigid body with Euler parameters (math-spec V12).
+//! A torque-free spatial rigid body with Euler parameters (docs/theory.md V12).
 
-/// Torque-free rigid body oriented by Euler parameters (math-spec V12).
+/// Torque-free rigid body oriented by Euler parameters (docs/theory.md V12).
 ///
 /// Body-frame inertia $\bar I = \operatorname{diag}(1, 1, 2)$, unit mass, no gravity.
 /// It starts at $\theta = (1, 0, 0, 0)$ with $\bar\omega(0) = (1, 0, 2)$, so

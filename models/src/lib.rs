@@ -2,7 +2,7 @@
 //!
 //! Each model lives in its own file as an inline module annotated with
 //! `#[pfaff::mechanism]`; the module name is the model name, and coordinate and parameter
-//! names follow the references (`benchmark-models.md`, `math-spec.md`) so that results can
+//! names follow the references (`docs/models.md`, `docs/theory.md`) so that results can
 //! be compared by name. [`all`] lists them for the command-line program.
 //!
 //! | model | coordinates | constraints |
@@ -21,10 +21,10 @@
 //! | [`chain10`] | `xi yi zi e0_i … e3_i`, `i = 1 … 10` | 40 holonomic (10 ball joints, 10 normalizations) |
 //! | [`bouncing_ball`] | `y` | 1 contact |
 //! | [`falling_rod`] | `x y phi` | 2 contacts |
-//! | [`pendulum_floor`] | `x1 y1 phi1 x2 y2 phi2` | 4 holonomic, 1 contact (math-spec V15) |
-//! | [`sleigh_wall`] | `x y phi` | 1 non-holonomic, 1 contact (math-spec V16) |
-//! | [`body_impact`] | `x y phi` | 1 contact (math-spec V13) |
-//! | [`two_body_impact`] | `x1 y1 phi1 x2 y2 phi2` | 1 contact (math-spec V14) |
+//! | [`pendulum_floor`] | `x1 y1 phi1 x2 y2 phi2` | 4 holonomic, 1 contact (docs/theory.md V15) |
+//! | [`sleigh_wall`] | `x y phi` | 1 non-holonomic, 1 contact (docs/theory.md V16) |
+//! | [`body_impact`] | `x y phi` | 1 contact (docs/theory.md V13) |
+//! | [`two_body_impact`] | `x1 y1 phi1 x2 y2 phi2` | 1 contact (docs/theory.md V14) |
 //! | [`newtons_cradle`] | `theta1 theta2 theta3` | 2 contacts |
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
 //! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
@@ -155,7 +155,7 @@ static ALL: &[Entry] = &[
     },
     Entry {
         name: "slider_crank",
-        summary: "planar slider-crank in absolute coordinates, driven crank (math-spec V10)",
+        summary: "planar slider-crank in absolute coordinates, driven crank (docs/theory.md V10)",
         make: || Box::new(slider_crank::Model::default()),
         stiff: false,
     },
@@ -173,7 +173,7 @@ static ALL: &[Entry] = &[
     },
     Entry {
         name: "free_body",
-        summary: "torque-free spatial rigid body with Euler parameters (math-spec V12)",
+        summary: "torque-free spatial rigid body with Euler parameters (docs/theory.md V12)",
         make: || Box::new(free_body::Model::default()),
         stiff: false,
     },
@@ -215,19 +215,19 @@ static ALL: &[Entry] = &[
     },
     Entry {
         name: "sleigh",
-        summary: "Chaplygin sleigh, non-holonomic knife edge (math-spec V11)",
+        summary: "Chaplygin sleigh, non-holonomic knife edge (docs/theory.md V11)",
         make: || Box::new(sleigh::Model::default()),
         stiff: false,
     },
     Entry {
         name: "seed2_example1",
-        summary: "free motion with redundant coordinates, example 1 (math-spec §8.8, V2)",
+        summary: "free motion with redundant coordinates, example 1 (docs/theory.md §free-motion-examples, V2)",
         make: || Box::new(seed2_example1::Model::default()),
         stiff: false,
     },
     Entry {
         name: "seed2_example2",
-        summary: "free motion with redundant coordinates, example 2 (math-spec §8.8, V4)",
+        summary: "free motion with redundant coordinates, example 2 (docs/theory.md §free-motion-examples, V4)",
         make: || Box::new(seed2_example2::Model::default()),
         stiff: false,
     },
@@ -251,25 +251,25 @@ static ALL: &[Entry] = &[
     },
     Entry {
         name: "pendulum_floor",
-        summary: "double pendulum striking a floor, impulsive joint reactions (math-spec V15)",
+        summary: "double pendulum striking a floor, impulsive joint reactions (docs/theory.md V15)",
         make: || Box::new(pendulum_floor::Model::default()),
         stiff: false,
     },
     Entry {
         name: "sleigh_wall",
-        summary: "Chaplygin sleigh striking a wall, jump of the non-holonomic reaction (math-spec V16)",
+        summary: "Chaplygin sleigh striking a wall, jump of the non-holonomic reaction (docs/theory.md V16)",
         make: || Box::new(sleigh_wall::Model::default()),
         stiff: false,
     },
     Entry {
         name: "body_impact",
-        summary: "free planar body striking a floor with a corner (math-spec V13)",
+        summary: "free planar body striking a floor with a corner (docs/theory.md V13)",
         make: || Box::new(body_impact::Model::default()),
         stiff: false,
     },
     Entry {
         name: "two_body_impact",
-        summary: "two free planar bodies colliding, a disk and a rod (math-spec V14)",
+        summary: "two free planar bodies colliding, a disk and a rod (docs/theory.md V14)",
         make: || Box::new(two_body_impact::Model::default()),
         stiff: false,
     },

@@ -1,7 +1,7 @@
 //! Newton's cradle: three balls on strings, two contacts closed at rest
-//! (benchmark-models.md).
+//! (docs/models.md).
 
-/// Newton's cradle with three equal balls (benchmark-models.md).
+/// Newton's cradle with three equal balls (docs/models.md).
 ///
 /// Balls of mass `m` and radius `r` hang on strings of length `l` from pivots `2r`
 /// apart, so that they touch at rest; `theta1`–`theta3` are the string angles from the

@@ -1,5 +1,5 @@
 //! The IFToMM A01 simple pendulum, written in redundant Cartesian coordinates so that
-//! its single holonomic constraint exercises the multipliers (benchmark-models.md).
+//! its single holonomic constraint exercises the multipliers (docs/models.md).
 
 /// Simple pendulum in redundant Cartesian coordinates (IFToMM A01).
 ///

@@ -1,7 +1,7 @@
-//! The double pendulum of math-spec V15 striking a floor: an impact with holonomic
+//! The double pendulum of docs/theory.md V15 striking a floor: an impact with holonomic
 //! constraints and impulsive joint reactions.
 
-/// Double pendulum of two uniform rods striking a floor with its tip (math-spec V15).
+/// Double pendulum of two uniform rods striking a floor with its tip (docs/theory.md V15).
 ///
 /// Rods of length `l`, mass `m` and moment of inertia `m l²/12`, in Cartesian
 /// coordinates of their centres and their angles; rod 1 is pinned to the ground at the

@@ -1,6 +1,6 @@
 //! A thin uniform disk rolling without slip on a horizontal plane.
 
-/// Thin uniform disk rolling without slip on the plane `z = 0` (benchmark-models.md).
+/// Thin uniform disk rolling without slip on the plane `z = 0` (docs/models.md).
 ///
 /// The disk's frame has its origin at the centre `(x, y, z)` and turns by the heading
 /// `psi` about the vertical, the lean `phi` about the new x axis and the spin `theta`

@@ -1,7 +1,7 @@
 //! Example 1 of Chen, Wu and Mei (2016), "Free motion of holonomic system with
-//! redundant coordinates" (math-spec.md §8.8, cases V1 and V2).
+//! redundant coordinates" (docs/theory.md §free-motion-examples, cases V1 and V2).
 
-/// Free motion with redundant coordinates, example 1 (math-spec §8.8, V2).
+/// Free motion with redundant coordinates, example 1 (docs/theory.md §free-motion-examples, V2).
 ///
 /// Three unit masses, $T = \tfrac12(\dot q_1^2 + \dot q_2^2 + \dot q_3^2)$, on the moving
 /// plane $f = t q_1 + 2 q_2 - 3 q_3 = 0$. The applied force $Q = (0, -\dot q_1, 0)$ makes the

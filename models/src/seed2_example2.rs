@@ -1,7 +1,7 @@
 //! Example 2 of Chen, Wu and Mei (2016), "Free motion of holonomic system with
-//! redundant coordinates" (math-spec.md §8.8, cases V3 and V4).
+//! redundant coordinates" (docs/theory.md §free-motion-examples, cases V3 and V4).
 
-/// Free motion with redundant coordinates, example 2 (math-spec §8.8, V4).
+/// Free motion with redundant coordinates, example 2 (docs/theory.md §free-motion-examples, V4).
 ///
 /// A time-dependent inertia, $T = \tfrac12[(2 + \sin t)\dot q_1^2 + \dot q_2^2 + \dot q_3^2]$,
 /// and the rheonomic constraint $f = t^2 q_1 - q_2 - q_3 = 0$. The applied force

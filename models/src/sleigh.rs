@@ -1,7 +1,7 @@
 //! The Chaplygin sleigh: a rigid body on a knife edge, the simplest non-holonomic
-//! mechanism (benchmark-models.md, case V11 of math-spec.md).
+//! mechanism (docs/models.md, case V11 of docs/theory.md).
 
-/// Chaplygin sleigh: a planar rigid body sliding on a knife edge (math-spec V11).
+/// Chaplygin sleigh: a planar rigid body sliding on a knife edge (docs/theory.md V11).
 ///
 /// The centre of mass is at $(x, y)$ and the body axis makes the angle $\varphi$ with
 /// the x axis. The blade sits a distance `a` behind the centre of mass on the body axis

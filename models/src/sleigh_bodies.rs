@@ -1,6 +1,6 @@
 //! The Chaplygin sleigh of `sleigh` written with a body and a knife edge.
 
-/// Chaplygin sleigh from the body level: a planar body on a `KnifeEdge` (math-spec V11).
+/// Chaplygin sleigh from the body level: a planar body on a `KnifeEdge` (docs/theory.md V11).
 ///
 /// Same coordinates, parameters and initial state as `sleigh`; the kinetic energy and the
 /// non-holonomic row are generated: the blade point, `a` behind the centre of mass on the

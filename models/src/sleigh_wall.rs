@@ -1,7 +1,7 @@
-//! The Chaplygin sleigh of math-spec V11 striking a wall: an impact with a
-//! non-holonomic constraint (math-spec V16).
+//! The Chaplygin sleigh of docs/theory.md V11 striking a wall: an impact with a
+//! non-holonomic constraint (docs/theory.md V16).
 
-/// Chaplygin sleigh whose front tip strikes a wall (math-spec V16).
+/// Chaplygin sleigh whose front tip strikes a wall (docs/theory.md V16).
 ///
 /// The sleigh of `sleigh` (mass `m`, inertia `ic`, blade `a` behind the centre of mass)
 /// with its front tip `tip` ahead of the centre of mass on the body axis; the wall is the

@@ -1,7 +1,7 @@
-//! The planar slider-crank of case V10 of math-spec.md, in absolute coordinates: three
+//! The planar slider-crank of case V10 of docs/theory.md, in absolute coordinates: three
 //! bodies, each with the position of its centre and its angle.
 
-/// Planar slider-crank in absolute coordinates (math-spec V10), driven at constant speed.
+/// Planar slider-crank in absolute coordinates (docs/theory.md V10), driven at constant speed.
 ///
 /// The crank (body 1, length `a`) is pinned at the origin O; its centre is at
 /// $\tfrac a2 u(\varphi_1)$ with $u(\varphi) = (\cos\varphi, \sin\varphi)$. The coupler

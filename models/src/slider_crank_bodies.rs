@@ -1,8 +1,8 @@
-//! The planar slider-crank of case V10 of math-spec.md written with bodies and joints:
+//! The planar slider-crank of case V10 of docs/theory.md written with bodies and joints:
 //! the same mechanism, coordinates and parameters as `slider_crank`, with the kinetic
 //! energy, gravity and the nine constraints generated from the body level.
 
-/// Planar slider-crank in absolute coordinates (math-spec V10) from bodies and joints.
+/// Planar slider-crank in absolute coordinates (docs/theory.md V10) from bodies and joints.
 ///
 /// Each body's frame has its origin at the body's centre: the crank (length `a`) is
 /// pinned to the ground at its left end, joined to the coupler (length `b`) at its right

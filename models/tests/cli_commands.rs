@@ -360,7 +360,7 @@ fn every_formulation_and_integrator_runs() {
                 (v["formulation"].as_str(), v["integrator"].as_str()),
                 (Some(f), Some(i))
             );
-            // math-spec V11 at t = 1: phi = 0.176360706663.
+            // docs/theory.md V11 at t = 1: phi = 0.176360706663.
             let phi = v["final"]["q"]["phi"].as_f64().unwrap();
             assert!((phi - 0.176_360_706_663).abs() < 1e-3, "{f} {i}: {phi}");
         }
@@ -417,7 +417,7 @@ fn linearize_sleigh_at_a_speed() {
 /// The steady motion is the whole operating point: the model's declared initial
 /// velocities (the bicycle starts with a lean rate, the sleigh turning) do not leak
 /// into it. At 5 m/s the bicycle's eigenvalues are those of Meijaard et al. (2007) as
-/// quoted in benchmark-models.md, plus the neutral forward speed.
+/// quoted in docs/models.md, plus the neutral forward speed.
 #[test]
 fn linearize_bicycle_at_its_benchmark_speed() {
     let out = pfaff(&["linearize", "bicycle", "--speed", "5", "--json"]);

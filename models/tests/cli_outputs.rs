@@ -17,7 +17,7 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-/// math-spec V12: the torque-free body's body-frame angular velocity is
+/// docs/theory.md V12: the torque-free body's body-frame angular velocity is
 /// $\bar\omega(t) = (\cos 2t, \sin 2t, 2)$.
 fn omega(t: f64) -> [f64; 3] {
     [(2.0 * t).cos(), (2.0 * t).sin(), 2.0]
@@ -40,7 +40,7 @@ fn free_body_outputs_follow_the_closed_form_of_v12() {
     ]);
     let fin = &v["final"]["outputs"];
     let w = omega(1.0);
-    // math-spec V12 at t = 1: (-0.416146836547, 0.909297426826, 2).
+    // docs/theory.md V12 at t = 1: (-0.416146836547, 0.909297426826, 2).
     for (name, expected) in ["omega_x", "omega_y", "omega_z"].iter().zip(w) {
         let got = num(&fin[*name]);
         assert!((got - expected).abs() < 1e-8, "{name}: {got} vs {expected}");

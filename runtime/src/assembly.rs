@@ -1,4 +1,4 @@
-//! Assembly: consistent initial conditions (math-spec §6, "Initial conditions").
+//! Assembly: consistent initial conditions (docs/theory.md §initial-conditions).
 //!
 //! Input: a guess $(q, \dot q)$ and a [`Prescription`] of coordinates and velocities by
 //! name (e.g. `phi1 = π/6`, `phi1' = 10`). Output: $q$ with $C(q,t) = 0$ and $\dot q$

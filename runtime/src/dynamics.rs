@@ -1,4 +1,4 @@
-//! Accelerations and multipliers from the augmented system (math-spec §5, E31).
+//! Accelerations and multipliers from the augmented system (docs/theory.md §augmented, E31).
 //!
 //! Input: $(q, \dot q, t)$ and a [`Workspace`]. Output: $\ddot q$ and
 //! $\lambda = [\lambda_h; \lambda_{nh}]$ solving
@@ -6,7 +6,7 @@
 //!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix},\qquad J = \begin{bmatrix}C_q\\ G\end{bmatrix},
 //!   \quad \gamma = \begin{bmatrix}\gamma_h\\ \gamma_{nh}\end{bmatrix},$$
-//! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of math-spec §1).
+//! i.e. $M\ddot q + J^\mathsf{T}\lambda = Q$ (sign convention of docs/theory.md §sign).
 //!
 //! **Paths.** The model's own solve ([`Mechanism::augmented_solve`]: a sparse
 //! $LDL^\mathsf{T}$ the generator specialized to the patterns of $M$ and $J$, every
@@ -349,7 +349,7 @@ struct Check<'a> {
 const INDEPENDENT: f64 = 10.0;
 
 /// Safety factor on the first-order bound of the acceleration residual of a row that
-/// is dependent only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): the
+/// is dependent only near a rank drop (docs/decisions/0036-through-a-rank-drop.md): the
 /// bound's rate of the rows is estimated from $\gamma$.
 const RANK_DROP_SAFETY: f64 = 4.0;
 
@@ -845,7 +845,7 @@ impl Split {
     ///
     /// The rows $D$ must meet $\ddot q$ to the relative `redundant_tolerance`, or, with
     /// the state's velocities, within the first-order bound of a row that is dependent
-    /// only near a rank drop (ARCHITECTURE.md, "Through a rank drop"): with
+    /// only near a rank drop (docs/decisions/0036-through-a-rank-drop.md): with
     /// $T_d = X_d^\mathsf{T}$ the least-squares combination of the rows $R$ and
     /// $w_d = J_d - T_d J_R$ what the row adds to them,
     /// $|J_d\ddot q - \gamma_d| \le 2\lVert\dot w_d\rVert\,|v_d - T_d v_R| / \lVert w_d\rVert$,

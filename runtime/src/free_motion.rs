@@ -1,10 +1,10 @@
-//! Free motion of constrained systems (math-spec §8, the second seed paper \[S2\]: Chen,
+//! Free motion of constrained systems (docs/theory.md §redundant-coordinates, the second seed paper \[S2\]: Chen,
 //! Wu & Mei 2016, "Free motion of holonomic system with redundant coordinates").
 //!
 //! Input: a [`Mechanism`] with a regular mass matrix $A = M$, a [`Workspace`], states
 //! $(t, q, \dot q)$ and a choice of applied forces ([`AppliedForces`]). Output: the
 //! explicit multiplier formula of \[S2\] and the free-motion residual, in the sign of
-//! \[S2\] (§8.5):
+//! \[S2\] (docs/theory.md §redundant-multipliers):
 //! $$A\ddot q = h + F^\mathsf{T}\lambda^{[\text{S2}]},\qquad W = F A^{-1} F^\mathsf{T},\qquad
 //!   w = c + F A^{-1} h,\qquad \lambda^{[\text{S2}]} = -W^{-1} w,$$
 //! with $F = J = [C_q; G]$, $c = -\gamma$ (for holonomic rows
@@ -21,7 +21,7 @@
 //! multiplier, and still $\lambda = 0 \iff w = 0$.
 //!
 //! Principal items:
-//! - [`FreeMotion::evaluate`]: everything of §8.5 at one state ([`FreeMotionPoint`]);
+//! - [`FreeMotion::evaluate`]: everything of docs/theory.md §redundant-multipliers at one state ([`FreeMotionPoint`]);
 //! - [`FreeMotion::check_along`]: is a motion free along a trajectory
 //!   ([`FreeMotionReport`]);
 //! - [`FreeMotion::free_forces`]: the applied forces that make the motion free
@@ -33,7 +33,7 @@
 //!   state, to simulate the designed motion.
 //!
 //! Invariant: [`FreeMotion::evaluate`] does not allocate except on a singular $W$.
-//! A singular mass matrix (Euler parameters, math-spec §11 item 15) is an error: use the
+//! A singular mass matrix (Euler parameters, docs/theory.md §singular-mass) is an error: use the
 //! augmented solve ([`ReactionAnalysis`](crate::ReactionAnalysis)) and check
 //! $\lambda \equiv 0$ there.
 
@@ -139,7 +139,7 @@ pub enum FreeMotionError {
     Eval(#[from] EvalError),
 }
 
-/// Everything of math-spec §8.5 at one state, in the sign of \[S2\].
+/// Everything of docs/theory.md §redundant-multipliers at one state, in the sign of \[S2\].
 #[derive(Clone, Debug, PartialEq)]
 #[allow(non_snake_case)]
 pub struct FreeMotionPoint {
@@ -194,7 +194,7 @@ impl FreeMotionPoint {
         }
     }
 
-    /// The multipliers in the sign of math-spec §1, $\lambda = -\lambda^{[\text{S2}]}$.
+    /// The multipliers in the sign of docs/theory.md §sign, $\lambda = -\lambda^{[\text{S2}]}$.
     #[must_use]
     pub fn lambda(&self) -> Vec<f64> {
         self.lambda_s2.iter().map(|l| -l).collect()
@@ -222,7 +222,7 @@ pub struct FreeMotionReport {
     pub worst_t: f64,
     /// The tolerance on $\lVert R\rVert_\infty$ the verdict used.
     pub tolerance: f64,
-    /// $\lVert R\rVert_\infty \le$ `tolerance` at every state (math-spec §8.9 step 2).
+    /// $\lVert R\rVert_\infty \le$ `tolerance` at every state (docs/theory.md §free-motion-analysis step 2).
     pub free: bool,
 }
 
@@ -260,7 +260,7 @@ impl FreeMotion {
     }
 
     /// The explicit multipliers and the free-motion residual at $(q, \dot q, t)$
-    /// (math-spec §8.5–§8.6). $q$ need not satisfy the constraints: the formulas hold
+    /// (docs/theory.md §redundant-multipliers). $q$ need not satisfy the constraints: the formulas hold
     /// pointwise.
     ///
     /// # Errors

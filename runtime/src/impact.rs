@@ -1,12 +1,12 @@
 //! Impacts: the generalized impulse–momentum solve with holonomic and non-holonomic
-//! constraints (math-spec §7, Algorithm I-solve).
+//! constraints (docs/theory.md §impacts, Algorithm I-solve).
 //!
 //! Input: a model with contacts ([`Info::contacts`]: gaps $\delta_c(q, t)$, their normal
 //! Jacobians $D_c = \partial\delta_c/\partial q$ and restitution parameters $e_c$), the
 //! impact configuration $(t, q)$, the pre-impact velocities $\dot q^-$ and the contacts
 //! that strike. Output: an [`Impact`]: $\dot q^+$, the normal impulse $\hat P_c$ of each
 //! contact, the impulsive reaction $\Lambda$ of every named constraint, the finite
-//! multipliers before and after (their jump, math-spec §7.4) and the kinetic energy
+//! multipliers before and after (their jump, docs/theory.md §multiplier-jump) and the kinetic energy
 //! before and after.
 //!
 //! **The augmented form (E41).** With $J = [C_q; G]$ and the normal velocities
@@ -105,7 +105,7 @@ impl Impact {
     }
 
     /// The jump $\Delta\lambda = \lambda^+ - \lambda^-$ of the finite multipliers
-    /// (math-spec §7.4).
+    /// (docs/theory.md §multiplier-jump).
     #[must_use]
     pub fn multiplier_jump(&self) -> Vec<f64> {
         self.lambda_after

@@ -7,7 +7,7 @@
 //!
 //! **The mapping.** A joint's rows $R$ (its holonomic and non-holonomic constraints)
 //! push on the system with the generalized force $Q_R = -J_R^\mathsf{T}\lambda_R$
-//! (math-spec §5; [`Reactions::constraint_force`] summed over the rows). The joint
+//! (docs/theory.md §augmented; [`Reactions::constraint_force`] summed over the rows). The joint
 //! transmits a wrench: a force $F$ acting on its first frame $a$ at the frame's origin
 //! $o_a$ and a torque $T$ on $a$, and by Newton's third law $-F$ at the same point and
 //! $-T$ on its second frame $b$ (the ground when absent). By virtual power, that wrench
@@ -230,7 +230,7 @@ impl JointReactions {
     }
 
     /// The joint reactions at $(t, q)$ for the multipliers `lambda`
-    /// ($[\lambda_h; \lambda_{nh}]$, sign of math-spec §1, as in [`Reactions`]).
+    /// ($[\lambda_h; \lambda_{nh}]$, sign of docs/theory.md §sign, as in [`Reactions`]).
     ///
     /// Evaluates `frame_poses` $1 + 4n$ times and the holonomic Jacobian once (not a
     /// per-step path: the fit allocates a few small vectors per joint).

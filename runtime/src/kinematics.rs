@@ -1,4 +1,4 @@
-//! Kinematic analysis with a coordinate partition (math-spec §6, Algorithm K).
+//! Kinematic analysis with a coordinate partition (docs/theory.md §partitioning, Algorithm K).
 //!
 //! - **K1, position** ([`Kinematics::position`]): Newton–Raphson on the dependent
 //!   coordinates $\beta$ with $p = [\eta; \gamma]$ fixed,

@@ -6,7 +6,7 @@
 //! values of their structurally non-zero entries, in the order of the pattern that
 //! [`Info`] exports (row-major, sorted by row then column).
 //!
-//! Sign convention (math-spec §1): the equations of motion are
+//! Sign convention (docs/theory.md §sign): the equations of motion are
 //! $M\ddot q + C_q^\mathsf{T}\lambda^h + G^\mathsf{T}\lambda^{nh} = Q$, so the generalized
 //! constraint force is $-J^\mathsf{T}\lambda$.
 
@@ -417,7 +417,7 @@ pub trait Mechanism {
         out.fill(0.0);
     }
 
-    /// The free-motion residual of math-spec §8.6 (S2-18) with the applied forces
+    /// The free-motion residual of docs/theory.md §free-motion (S2-18) with the applied forces
     /// `applied` in place of the model's own (length `n`): for every constraint, holonomic
     /// rows first, $w = -\gamma + J M^{-1}(Q^0 + Q)$ with
     /// $Q^0 = $ `forces − applied_forces` (so $w = c + F A^{-1} h$ in the notation of

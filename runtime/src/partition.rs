@@ -1,4 +1,4 @@
-//! Generalized coordinate partitioning (math-spec §6, Algorithm P) and its condition
+//! Generalized coordinate partitioning (docs/theory.md §partitioning, Algorithm P) and its condition
 //! monitor.
 //!
 //! Input: a configuration $(q, t)$ (consistent or not) and the Jacobian
@@ -44,7 +44,7 @@ use crate::{Info, Mechanism};
 /// dependent are dropped by every analysis at the same distance, and taken back by
 /// every analysis when the motion leaves it. Between $10^{-8}$ (the chart's maps lose
 /// half the digits) and $10^{-3}$ (the dropped rows' own reactions start to matter,
-/// ARCHITECTURE.md, "Through a rank drop"): $10^{-5}$.
+/// docs/decisions/0036-through-a-rank-drop.md): $10^{-5}$.
 pub const RANK_PIVOT: f64 = 1e-5;
 
 /// Tuning of Algorithm P.

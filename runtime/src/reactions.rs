@@ -8,7 +8,7 @@
 //! $-C_q^\mathsf{T}\lambda_h$, $-G^\mathsf{T}\lambda_{nh}$ and the total
 //! $F^c = -J^\mathsf{T}\lambda$.
 //!
-//! **Signs.** math-spec §1: $M\ddot q + C_q^\mathsf{T}\lambda_h + G^\mathsf{T}\lambda_{nh}
+//! **Signs.** docs/theory.md §sign: $M\ddot q + C_q^\mathsf{T}\lambda_h + G^\mathsf{T}\lambda_{nh}
 //! = Q$, so constraint $k$ pushes on the system with $-J_k^\mathsf{T}\lambda_k$. The
 //! second seed paper (\[S2\], Chen, Wu & Mei 2016) writes the multiplier term on the
 //! right-hand side, $\lambda^{[\text{S2}]} = -\lambda$, and its constraint force
@@ -47,7 +47,7 @@ pub struct ConstraintReaction<'a> {
     pub kind: ConstraintKind,
     /// Row in $J = [C_q; G]$ (and in $\lambda$).
     pub row: usize,
-    /// Its multiplier $\lambda_k$ (sign of math-spec §1).
+    /// Its multiplier $\lambda_k$ (sign of docs/theory.md §sign).
     pub lambda: f64,
     /// Its generalized force $-J_k^\mathsf{T}\lambda_k$ (length $n$).
     pub force: &'a [f64],
@@ -63,7 +63,7 @@ pub struct Reactions {
     pub t: f64,
     /// Accelerations $\ddot q$.
     pub qdd: Vec<f64>,
-    /// $\lambda = [\lambda_h; \lambda_{nh}]$, sign of math-spec §1.
+    /// $\lambda = [\lambda_h; \lambda_{nh}]$, sign of docs/theory.md §sign.
     pub lambda: Vec<f64>,
     /// Row-major $m \times n$: row $k$ is $-J_k^\mathsf{T}\lambda_k$.
     forces: Vec<f64>,

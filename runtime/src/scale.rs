@@ -2,7 +2,7 @@
 //!
 //! A decision that compares a number with an absolute threshold changes its outcome
 //! with the units of the model. The runtime's decisions are made against these scales
-//! instead (ARCHITECTURE.md, "Decision: the scale model"):
+//! instead (`docs/decisions/0041-scale-model.md`):
 //!
 //! - **the size of $q$**: $s_q = \lVert q\rVert_\infty$, the precision to which the
 //!   coordinates can be known;

@@ -1,5 +1,5 @@
 //! The error of cutting a body's modes (issue 12, "modes cut by a parameter"): the
-//! spin-up beam of benchmark-models.md (l = 10, EI = 1.4e4, EA = 2.8e7, ρA = 1.2),
+//! spin-up beam of docs/models.md (l = 10, EI = 1.4e4, EA = 2.8e7, ρA = 1.2),
 //! 16 clamped elements, reduced to n = 1 … 16 modes, against the unreduced model
 //! (45 coordinates).
 //!

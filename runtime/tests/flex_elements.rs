@@ -1,4 +1,4 @@
-//! Beam elements and their assembly (math-spec §3.5–§3.8, case V9): element matrices,
+//! Beam elements and their assembly (docs/theory.md §finite-elements, case V9): element matrices,
 //! element shape integrals, frames, rigid-body motions and the kinetic energy of rigid
 //! motions of meshes in arbitrary orientation.
 
@@ -55,7 +55,7 @@ fn planar_element_matrices_e19() {
     assert!((inv.mass - rho_a * l).abs() < 1e-14);
 }
 
-/// §3.7: the element shape integrals ∫ρA S dx and ∫ρA SᵀĨS dx = S̄₂₁ − S̄₁₂ (V6, V9).
+/// docs/theory.md §beam-elements: the element shape integrals ∫ρA S dx and ∫ρA SᵀĨS dx = S̄₂₁ − S̄₁₂ (V6, V9).
 #[test]
 fn planar_element_shape_integrals() {
     let (l, rho_a) = (0.8, 3.1);
@@ -94,7 +94,7 @@ fn planar_element_shape_integrals() {
     );
 }
 
-/// §3.8: the spatial stiffness table and the consistent-mass check values (with rotary
+/// docs/theory.md §beam-elements: the spatial stiffness table and the consistent-mass check values (with rotary
 /// inertia), from the quadrature of E20.
 #[test]
 fn spatial_element_matrices() {
@@ -135,7 +135,7 @@ fn spatial_element_matrices() {
     put(6, 6, 4.0 * eiz / l);
     put(12, 12, 4.0 * eiz / l);
     put(6, 12, 2.0 * eiz / l);
-    assert_close("K (§3.8)", &inv.k_ff, &k, 1e-14);
+    assert_close("K (§beam-elements)", &inv.k_ff, &k, 1e-14);
 
     // ρA = rho_a, ρI_y = rho_iy, ρI_z = rho_iz in the check values.
     let m = &inv.m_ff;
@@ -359,7 +359,7 @@ fn rigid_motion_kinetic_energy() {
     }
 }
 
-/// A planar centre-line body has ū_o = N q_o (§3.5), q_o the nodal positions with zero
+/// A planar centre-line body has ū_o = N q_o (docs/theory.md §finite-elements), q_o the nodal positions with zero
 /// rotations: then Ī1 = S̄ q_o, Ī_kl = q_oᵀ S̄_kl and I_kl = q_oᵀ S̄_kl q_o (E10, E11).
 #[test]
 fn planar_centre_line_integrals_from_nodal_positions() {

@@ -1,6 +1,6 @@
-//! Reference conditions, modal reduction and Craig–Bampton (math-spec §3.9, case V9):
+//! Reference conditions, modal reduction and Craig–Bampton (docs/theory.md §reduction, case V9):
 //! cantilever frequencies against the table of V9 and the closed-form Euler–Bernoulli
-//! values, the spin-up beam's first frequency (benchmark-models.md), M → I and
+//! values, the spin-up beam's first frequency (docs/models.md), M → I and
 //! K → diag(ω²), and Craig–Bampton against the full model.
 
 use pfaff::flex::{Beam, Dim, FlexError, Mesh, Reduction, Reference, Section};
@@ -73,7 +73,7 @@ fn v9_cantilever_table() {
     }
 }
 
-/// benchmark-models.md, `spinup_beam`: the first non-rotating bending frequency of the
+/// docs/models.md, `spinup_beam`: the first non-rotating bending frequency of the
 /// clamped beam (l = 10, EI = 1.4e4, ρA = 1.2) is 1.8751² √(EI/ρA)/l² = 3.7977 rad/s.
 #[test]
 fn spinup_beam_first_frequency() {
@@ -208,7 +208,7 @@ fn spatial_cantilever_closed_forms() {
     }
 }
 
-/// §3.9 (b): a simply supported planar beam (u₁ = v₁ = v_N = 0) has the pinned–pinned
+/// docs/theory.md §reduction, simply supported: a simply supported planar beam (u₁ = v₁ = v_N = 0) has the pinned–pinned
 /// bending frequencies (kπ)² √(EI/ρA)/L²; a spatial one along x (6 coordinates) too.
 #[test]
 fn simply_supported_frequencies() {

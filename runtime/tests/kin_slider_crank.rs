@@ -10,7 +10,7 @@ use pfaff::{
     Preferences, Prescription, SolverPath, Workspace,
 };
 
-#[allow(clippy::approx_constant)] // the table of math-spec V10, verbatim
+#[allow(clippy::approx_constant)] // the table of docs/theory.md V10, verbatim
 const Q: [f64; 9] = [
     0.043301270189,
     0.025,

@@ -1,8 +1,8 @@
-//! Verification case V17 item 4 of math-spec §10: a bouncing ball, integrated by each
+//! Verification case V17 item 4 of docs/theory.md §verification: a bouncing ball, integrated by each
 //! adaptive method with event location on the dense output and a restart after every
 //! impact; and item 5 through it: the Adams method begins again at order 1.
 //!
-//! Reference (closed form, benchmark-models.md `bouncing_ball`): dropped from height
+//! Reference (closed form, docs/models.md `bouncing_ball`): dropped from height
 //! $h$ at rest with restitution $e$, the first impact is at $t_1 = \sqrt{2h/g}$ with
 //! speed $v_0 = \sqrt{2gh}$, and the flight after impact $k$ lasts $2 e^k v_0 / g$, so
 //! $t_{k+1} = t_1 + \frac{2 v_0}{g}\, e\,\frac{1 - e^k}{1 - e}$ and the impacts

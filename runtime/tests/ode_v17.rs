@@ -1,8 +1,8 @@
-//! Verification case V17 of math-spec §10 (integrator), items 1, 2, 3 and 5, for
+//! Verification case V17 of docs/theory.md §verification (integrator), items 1, 2, 3 and 5, for
 //! DOPRI5, DOP853 and the Shampine–Gordon Adams port. Item 4 (bouncing ball with event
 //! location and restarts) is in `ode_events.rs`.
 //!
-//! Reference values: closed forms. $e^{-10} = 4.539992976248485\times10^{-5}$ (math-spec
+//! Reference values: closed forms. $e^{-10} = 4.539992976248485\times10^{-5}$ (docs/theory.md
 //! V17 item 1; `f64::exp(-10.0)` agrees to an ulp); the oscillator and the Kepler orbit (semi-major
 //! axis 1, so period $2\pi$ by Kepler's third law) return to their initial states.
 

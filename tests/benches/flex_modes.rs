@@ -1,5 +1,5 @@
 //! Cost of a deformable body as its number of modes grows: the spin-up beam
-//! (benchmark-models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 32 clamped
+//! (docs/models.md: l = 10, EA = 2.8e7, EI = 1.4e4, ρA = 1.2) of 32 clamped
 //! elements on a free hub, its invariants read from a beam data slot
 //! (`Beam { .., modes: n }`), for n = 4, 16 and 64 (issue 12). Timed:
 //! the generated `mass_matrix` and `forces` at a state with every coordinate and
@@ -9,7 +9,7 @@
 //! The mode count is a literal of the source: it fixes the generated code. The
 //! contractions of the slot's blocks with `q_f` and `q̇_f` are loops from 8 modes on
 //! (`macros/codegen/src/sched/runs.rs`), so the 64-mode body compiles (before, rustc failed
-//! with SIGSEGV after 12 minutes on this file; ARCHITECTURE.md, deformable bodies).
+//! with SIGSEGV after 12 minutes on this file; docs/decisions/0015-run-time-data-slots.md).
 //!
 //! `cargo bench -p pfaff-tests --bench flex_modes`
 

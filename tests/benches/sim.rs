@@ -2,8 +2,8 @@
 //! side evaluations and wall time, rtol = 1e-3 … 1e-12, every formulation × integrator.
 //!
 //! - `pendulum` over one period (2.36784194757624 s), against the exact solution
-//!   (benchmark-models.md, Jacobi sn by the AGM, A&S §16.4);
-//! - `sleigh` to t = 1, against math-spec V11 (φ and φ̇ = ω);
+//!   (docs/models.md, Jacobi sn by the AGM, A&S §16.4);
+//! - `sleigh` to t = 1, against docs/theory.md V11 (φ and φ̇ = ω);
 //! - `andrews` over [0, 0.03], against the best converged run (DOP853, rtol 1e-13,
 //!   partitioning; its distance to the same run with projection is printed).
 //!
@@ -12,7 +12,7 @@
 use pfaff::sim::{format_table, work_precision, Formulation, Method, Reference, Simulation, Sweep};
 use pfaff_models::{andrews, pendulum, sleigh};
 
-// K(1/2) as printed in benchmark-models.md.
+// K(1/2) as printed in docs/models.md.
 #[allow(clippy::excessive_precision)]
 const K_HALF: f64 = 1.854_074_677_301_371_918_43;
 
@@ -74,7 +74,10 @@ fn main() {
             impacts: Vec::new(),
         };
         let rows = work_precision(&sleigh::Model::default(), &Sweep::standard(1.0), &reference);
-        println!("## sleigh, t = 1, math-spec V11\n\n{}", format_table(&rows));
+        println!(
+            "## sleigh, t = 1, docs/theory.md V11\n\n{}",
+            format_table(&rows)
+        );
     }
     if want("andrews") {
         let model = andrews::Model::default();

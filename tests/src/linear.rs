@@ -182,7 +182,7 @@ fn lean_steer(lin: &Linearization) -> [[f64; 4]; 4] {
 }
 
 /// The published linear model of Meijaard, Papadopoulos, Ruina & Schwab (2007), Proc.
-/// R. Soc. A 463, eq. (A 20)–(A 23) as quoted in benchmark-models.md:
+/// R. Soc. A 463, eq. (A 20)–(A 23) as quoted in docs/models.md:
 /// `[0 I; −M⁻¹(g K0 + v² K2) −v M⁻¹ C1]`.
 fn published(v: f64) -> [[f64; 4]; 4] {
     let m = [
@@ -272,7 +272,7 @@ fn eigen4(a: &[[f64; 4]; 4]) -> Vec<Eigenvalue> {
 
 #[test]
 fn bicycle_eigenvalues_at_5_m_per_s() {
-    // benchmark-models.md (Meijaard et al. 2007, Table 2): v = 5 m/s.
+    // docs/models.md (Meijaard et al. 2007, Table 2): v = 5 m/s.
     let want = [
         (-14.078_389_692_798_22, 0.0),
         (-0.775_341_882_195_85, -4.464_867_713_788_23),

@@ -6,7 +6,7 @@
 use pfaff::flex::{Beam, Dim, Invariants, Reduction, Reference, Section};
 use pfaff::{DataError, Mechanism, MechanismExt};
 
-/// The spin-up beam of benchmark-models.md clamped in a fixed frame, reduced to its two
+/// The spin-up beam of docs/models.md clamped in a fixed frame, reduced to its two
 /// lowest modes `p1, p2`, written with the slot's modal mass and stiffness (flat layout
 /// of `Invariants::write_flat` for d = 2, n = 2: `M_ff` at 35..39, `K_ff` at 39..43).
 #[pfaff::mechanism]
@@ -80,7 +80,7 @@ fn beam_slot_is_filled_from_the_parameters() {
     assert_eq!(model.data(0), &slot(&reference_beam(1.4e4))[..]);
     assert_eq!(model.data(1), &[0.0; 3]);
     // The generated mass matrix is the modal one (identity), the forces −K p with
-    // K = diag(ω1², ω2²), ω1 = 3.7977 rad/s (benchmark-models.md).
+    // K = diag(ω1², ω2²), ω1 = 3.7977 rad/s (docs/models.md).
     let mut m = [0.0; 4];
     model.mass_matrix_dense_inplace(0.0, &[0.3, -0.2], &mut m);
     for (k, x) in m.iter().enumerate() {
@@ -279,7 +279,7 @@ mod hub_beam12 {
     };
 }
 
-/// math-spec V6 on a body from beam elements: the generated mass matrix and forces of
+/// docs/theory.md V6 on a body from beam elements: the generated mass matrix and forces of
 /// `hub_beam` equal E13 and E14 (with `−K_ff q_f`) evaluated from the `pfaff::flex`
 /// invariants, at random states, to 1e-12 relative.
 #[test]

@@ -141,7 +141,7 @@ impl Scene {
             },
             "sleigh" => Self {
                 t_end: 5.0,
-                span: "the span of math-spec V11",
+                span: "the span of docs/theory.md V11",
                 steady: Some(Steady {
                     coordinates: &[("x", 0.0), ("y", 0.0), ("phi", 0.0)],
                     velocities: &[("phi", 0.0)],
@@ -216,7 +216,7 @@ impl Scene {
             },
             "seed2_example1" => Self {
                 t_end: 2.0,
-                span: "the span of math-spec V2",
+                span: "the span of docs/theory.md V2",
                 steady: None,
                 closed_form: Some(seed2_example1_exact),
                 impact_times: None,
@@ -235,7 +235,7 @@ impl Scene {
             },
             "seed2_example2" => Self {
                 t_end: 1.0,
-                span: "the span of math-spec V4",
+                span: "the span of docs/theory.md V4",
                 steady: None,
                 closed_form: None,
                 impact_times: None,
@@ -263,7 +263,7 @@ impl Scene {
             },
             "pendulum_floor" | "sleigh_wall" | "body_impact" | "two_body_impact" => Self {
                 t_end: 1.0,
-                span: "1 s from the impact of its math-spec case",
+                span: "1 s from the impact of its docs/theory.md case",
                 steady: None,
                 closed_form: None,
                 impact_times: None,
@@ -273,7 +273,7 @@ impl Scene {
     }
 }
 
-/// The bouncing ball (benchmark-models.md) without pull: free fall from rest at `h`,
+/// The bouncing ball (docs/models.md) without pull: free fall from rest at `h`,
 /// impact n at t_n = T(1 + 2 Σ_{k=1}^{n-1} e^k), T = √(2h/g), leaving at e^n √(2gh);
 /// at rest on the ground from t∞ = T(1+e)/(1−e).
 fn bouncing_ball_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
@@ -339,7 +339,7 @@ fn falling_rod_impacts(model: &dyn Mechanism, t_end: f64) -> Vec<(&'static str, 
     }
 }
 
-/// The falling rod (benchmark-models.md) up to its second impact: the lower end strikes
+/// The falling rod (docs/models.md) up to its second impact: the lower end strikes
 /// at t* = (v − speed)/g, v = √(speed² + 2 g gap) (t* = gap/speed for g = 0), with the
 /// impulse P = (1+e) m v/(1 + 3cos²φ); then ẏ⁺ = −v + P/m, φ̇⁺ = −6 P cos φ/(m l), and
 /// free flight.
@@ -388,7 +388,7 @@ fn parameter(model: &dyn Mechanism, name: &str) -> f64 {
         .map_or(f64::NAN, |i| model.parameter(i))
 }
 
-/// The pendulum released at rest from x = l, y = 0 (benchmark-models.md): with θ from
+/// The pendulum released at rest from x = l, y = 0 (docs/models.md): with θ from
 /// the downward vertical, sin(θ/2) = k sn(K − ω0 t | 1/2), k = 1/√2, ω0 = √(g/l).
 fn pendulum_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
     const K: f64 = 1.854_074_677_301_371_9;
@@ -428,7 +428,7 @@ pub fn jacobi(u: f64, m: f64) -> (f64, f64, f64) {
     (sn, cn, (1.0 - m * sn * sn).sqrt())
 }
 
-/// The Chaplygin sleigh of math-spec V11 from its default state (forward speed v0 = 1,
+/// The Chaplygin sleigh of docs/theory.md V11 from its default state (forward speed v0 = 1,
 /// turning rate ω0 = 0.5 at φ = 0): v = V tanh(kt + c), ω = √(m/J) V sech(kt + c),
 /// φ = (√(J/m)/a)(gd(kt + c) − gd(c)), with J = ic + m a², V² = v0² + J ω0²/m,
 /// k = a m V/J, c = artanh(v0/V), gd the Gudermannian. Positions x, y need a quadrature,
@@ -460,7 +460,7 @@ fn sleigh_exact(model: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> 
     ]
 }
 
-/// math-spec V2: q = (1 + t, t − t²/2, t).
+/// docs/theory.md V2: q = (1 + t, t − t²/2, t).
 fn seed2_example1_exact(_: &dyn Mechanism, t: f64) -> Vec<(&'static str, f64, f64)> {
     vec![
         ("q1", 1.0 + t, 1.0),

@@ -1,5 +1,5 @@
 //! Two-node Euler–Bernoulli beam elements in their element frame: shape matrices
-//! (math-spec E18, E20), stiffness matrices (E19, §3.8) and the quadrature that
+//! (docs/theory.md E18, E20), stiffness matrices (E19, §beam-elements) and the quadrature that
 //! integrates their shape integrals exactly.
 //!
 //! Input: the element length $l$, its [`Section`] and a material point
@@ -157,7 +157,7 @@ pub(crate) fn planar_stiffness(l: f64, section: &Section) -> Vec<f64> {
     k
 }
 
-/// The spatial stiffness matrix of math-spec §3.8, row-major 12 × 12, from
+/// The spatial stiffness matrix of docs/theory.md §beam-elements, row-major 12 × 12, from
 /// $U_e = \tfrac12\int_0^l (EA u_0'^2 + EI_z v''^2 + EI_y w''^2 + GJ\varphi'^2)\,dx$.
 #[must_use]
 pub(crate) fn spatial_stiffness(l: f64, section: &Section) -> Vec<f64> {

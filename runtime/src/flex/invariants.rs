@@ -1,4 +1,4 @@
-//! The inertia shape integrals and stiffness of one deformable body (math-spec E10,
+//! The inertia shape integrals and stiffness of one deformable body (docs/theory.md E10,
 //! E11, E17) on `n` elastic coordinates, and their transformation to other coordinates
 //! $q_f = T p$.
 //!
@@ -188,7 +188,7 @@ impl Invariants {
     }
 
     /// The invariants on new coordinates $p$ with $q_f = T p$, `t` row-major `n × t_cols`
-    /// (math-spec E21): $\bar S T$, $\bar I_{kl} T$, $T^\mathsf{T}\bar S_{kl} T$,
+    /// (docs/theory.md E21): $\bar S T$, $\bar I_{kl} T$, $T^\mathsf{T}\bar S_{kl} T$,
     /// $T^\mathsf{T} M_{ff} T$, $T^\mathsf{T} K_{ff} T$; $m$, $\bar I_1$, $I_{kl}$ unchanged.
     ///
     /// # Panics

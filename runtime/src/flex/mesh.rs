@@ -1,5 +1,5 @@
 //! A body as a mesh of beam elements, and the assembly of its nodal invariants
-//! (math-spec E16, E17).
+//! (docs/theory.md E16, E17).
 //!
 //! Input: nodes in the body frame, elements with their sections. Output: [`Invariants`]
 //! on the body's nodal coordinates $q_n$ (node after node, each node's translations then
@@ -215,7 +215,7 @@ impl Mesh {
         Ok((c, l))
     }
 
-    /// The body's invariants on all its nodal coordinates (math-spec E10, E16, E17),
+    /// The body's invariants on all its nodal coordinates (docs/theory.md E10, E16, E17),
     /// integrated exactly.
     ///
     /// # Errors

@@ -1,9 +1,9 @@
 //! Deformable bodies from beam elements: inertia shape integrals, stiffness, reference
-//! conditions, modal reduction and Craig–Bampton (math-spec §3.2, §3.5–§3.9).
+//! conditions, modal reduction and Craig–Bampton (docs/theory.md §shape-integrals, §finite-elements).
 //!
 //! A body is a [`Mesh`]: nodes in the body frame and two-node Euler–Bernoulli beam
 //! elements between them, planar (E18, E19; 3 nodal coordinates `u, v, θ` per node) or
-//! spatial (E20 and the tables of §3.8; 6 per node `u_x, u_y, u_z, θ_x, θ_y, θ_z`). Each
+//! spatial (E20 and the tables of docs/theory.md §beam-elements; 6 per node `u_x, u_y, u_z, θ_x, θ_y, θ_z`). Each
 //! element has its frame $C_j$ (x along the element) and a [`Section`].
 //! [`Mesh::invariants`] assembles the body's [`Invariants`] (E10, E11, E16, E17) on the
 //! nodal coordinates, integrating every element exactly (Gauss–Legendre along the axis,

@@ -1,4 +1,4 @@
-//! Reference conditions, modal reduction and Craig–Bampton (math-spec §3.9, E21, E22).
+//! Reference conditions, modal reduction and Craig–Bampton (docs/theory.md §reduction, E21, E22).
 //!
 //! Input: a [`Mesh`]'s nodal invariants. Output: the invariants on fewer coordinates and
 //! the basis $T$ with $q_f = T p$ in nodal coordinates. The generalized symmetric
@@ -16,7 +16,7 @@ use faer::{Mat, MatRef, Par, Side};
 use super::{Dim, FlexError, Invariants, Mesh, Section};
 
 /// Which nodal coordinates define the floating frame, i.e. are deleted by $B_r$
-/// (math-spec §3.9).
+/// (docs/theory.md §reduction).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Reference {
     /// Clamped (tangent) frame at a node: all its coordinates are deleted.
@@ -440,7 +440,7 @@ impl Beam {
     /// $\vartheta_y = -w'$). A body spinning at $\bar\omega$ feels
     /// $-(\bar\omega_y^2 + \bar\omega_z^2)K_\Omega q_f$ (planar: $-\dot\theta^2 K_\Omega q_f$):
     /// the stress stiffening of the centrifugal tension, which the linear floating frame
-    /// lacks (math-spec §3.6). The integrand has degree 6 along an element: 5-point
+    /// lacks (docs/theory.md §finite-elements). The integrand has degree 6 along an element: 5-point
     /// Gauss–Legendre is exact.
     #[must_use]
     pub fn spin_stiffness(&self, t: &[f64], n: usize) -> Vec<f64> {

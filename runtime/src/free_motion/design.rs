@@ -1,9 +1,9 @@
-//! The inverse problems of math-spec §8.6 and §8.9 step 3 ("design mode").
+//! The inverse problems of docs/theory.md §free-motion and §free-motion-analysis step 3 ("design mode").
 //!
 //! - **Forces.** $w = w^0 + K Q$ is affine in the applied forces, so the forces that make
 //!   the motion free at a state are $Q \in F^\mathsf{T}\lambda^0 + \ker K$ with
 //!   $\lambda^0$ the \[S2\] multiplier of the system without applied forces (the design
-//!   remark of §8.6). [`ForceDesign`] picks one member: the least 2-norm one, the
+//!   remark of docs/theory.md §free-motion). [`ForceDesign`] picks one member: the least 2-norm one, the
 //!   would-be constraint forces $F^\mathsf{T}\lambda^0$ themselves (least
 //!   $A^{-1}$-norm), or the least-squares solution restricted to chosen components,
 //!   which is exact when the components can cancel $w^0$ and is reported as inexact
@@ -121,7 +121,7 @@ pub struct ParameterSolution {
 
 impl FreeMotion {
     /// Applied forces that make the motion free at $(q, \dot q, t)$, replacing the
-    /// model's declared ones (math-spec §8.6, design remark).
+    /// model's declared ones (docs/theory.md §free-motion, design).
     ///
     /// # Errors
     /// Those of [`FreeMotion::evaluate`]; [`FreeMotionError::Component`] for an index
@@ -197,7 +197,7 @@ impl FreeMotion {
     }
 
     /// The values of a model parameter for which the motion is free at every sample
-    /// state, with the given applied forces (math-spec §8.9 step 3 for a family of
+    /// state, with the given applied forces (docs/theory.md §free-motion-analysis step 3 for a family of
     /// constraints, inertias or forces).
     ///
     /// The samples may be arbitrary states (then a root makes $w \equiv 0$ identically

@@ -235,8 +235,9 @@ pub(crate) fn replace_state(
 /// that a step growing into faster motion is shortened before it fails. After a
 /// rejection the step is cut by $\text{err}^{1/q}/\text{safe}$ (at most by $\text{fac}_1$).
 ///
-/// [`PiController::gustafsson`] is the one in use; ARCHITECTURE.md ("The step-size
-/// control of the explicit pairs") has the measurements that chose it.
+/// [`PiController::gustafsson`] is the one in use;
+/// `docs/decisions/0025-explicit-pairs-step-size-control.md` has the measurements that
+/// chose it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PiController {
     expo1: f64,
@@ -289,7 +290,7 @@ const ERRACC_MIN: f64 = 1e-2;
 
 /// The safety factor of [`PiController::gustafsson`]: 0.85 rather than Hairer's 0.9,
 /// measured to keep the loose end of the work-precision curves monotone
-/// (ARCHITECTURE.md).
+/// (docs/decisions/0025-explicit-pairs-step-size-control.md).
 const SAFE: f64 = 0.85;
 
 impl PiController {

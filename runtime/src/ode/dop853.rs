@@ -59,8 +59,8 @@ pub(crate) struct Dp853 {
 /// Dispatched on the number of coefficients (1 to 12 in the tableau) so that the loop
 /// over the components runs with the stage derivatives' slices and the products
 /// $h a_j$ held outside it, no bounds check inside, and the compiler's vectorization
-/// across components; measured by instruction counts in ARCHITECTURE.md ("the
-/// stages' sums by the number of their terms").
+/// across components; measured by instruction counts in
+/// `benchmarks/measurements.md` ("The explicit pairs' stage sums").
 #[inline]
 fn combine(out: &mut [f64], y: &[f64], h: f64, coeffs: &[(usize, f64)], k: &[Vec<f64>]) {
     macro_rules! by_len {

@@ -5,7 +5,7 @@
 //! requested direction, located on the step's dense output to a time tolerance, with the
 //! interpolated state there.
 //!
-//! This is step 1 of the impact algorithm (math-spec §7.6): the caller applies the jump
+//! This is step 1 of the impact algorithm (docs/theory.md §impacts-in-a-run): the caller applies the jump
 //! at $t^*$ and restarts the integrator there with [`Integrator::reset`] (for the Adams
 //! method a return to order 1). The root is bracketed by the signs of $g$ at the two
 //! ends of the step and refined with the Illinois variant of regula falsi, which keeps a

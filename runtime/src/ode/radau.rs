@@ -49,7 +49,7 @@ use crate::linalg::small::SmallLu;
 /// like $h^5 \propto \text{rtol}'^{5/4}$: $e = 4/5$ makes it proportional to rtol
 /// (radau5.f's $2/3$ gives $\text{rtol}^{5/6}$, 78× rtol on the pendulum at 1e-12),
 /// and $c = 0.2$ puts it at 0.3–3 × rtol on the pendulum and car axis for rtol
-/// 1e-3…1e-12 (ARCHITECTURE.md, the Radau IIA decision).
+/// 1e-3…1e-12 (docs/decisions/0026-implicit-integrator-radau5.md).
 const TOL_FACTOR: f64 = 0.2;
 const TOL_EXPONENT: f64 = 0.8;
 /// Growth per accepted step of the step-size cap set by a failed stage iteration.
@@ -66,8 +66,9 @@ const FACL: f64 = 5.0;
 /// `min(0.03, rtol'^½)` of the tolerance, which at tight tolerances asks the stages for
 /// more digits than `f` has where the absolute tolerance is the scale (components near
 /// zero): such an iteration then "diverges" at every step size and the steps collapse
-/// (`spinup_beam`: 1,447 steps at rtol 1e-8, 86,701 at 1e-9; ARCHITECTURE.md, the
-/// Radau IIA decision). Stages known to a tenth of the tolerance are kept instead.
+/// (`spinup_beam`: 1,447 steps at rtol 1e-8, 86,701 at 1e-9;
+/// docs/decisions/0026-implicit-integrator-radau5.md). Stages known to a tenth of the
+/// tolerance are kept instead.
 const NEWTON_NOISE: f64 = 0.1;
 /// Contraction below which the Jacobian is reused (`THET`).
 const THET: f64 = 1e-3;

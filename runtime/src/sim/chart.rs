@@ -27,8 +27,8 @@
 //! generated [`Mechanism::orthogonal_solve`] (every built-in model with constraints),
 //! one call of it does this exactly: the system $[I\ J^\mathsf{T}; J\ 0]$ factored
 //! at the point by straight-line code specialized to the patterns, at the same cost
-//! whatever the distance from the anchor (ARCHITECTURE.md, "partitioning's
-//! velocities by a generated orthogonal solve"). Otherwise
+//! whatever the distance from the anchor
+//! (docs/decisions/0038-partitioning-velocities-by-generated-orthogonal-solve.md). Otherwise
 //! (no generated solve, or it declines: dependent or nearly dependent rows), the chord
 //! iteration
 //! $\dot q \leftarrow \dot q - J^\mathsf{T} G_a^{-1}(J\dot q + [C_t; g])$ with the inverse
@@ -66,8 +66,8 @@ pub(crate) const KAPPA: f64 = 0.03;
 /// own error. The dropped rows are dependent on the manifold only, so at a state
 /// $10^{-4}$ off it (0.03 of rtol 1e-3) `bricard`'s accelerations were off by order
 /// one, and its DOPRI5 runs gained 28 J of 32 at rtol 1e-3 where projection kept the
-/// energy to 2e-4 J; with this fraction, 6e-4 J (ARCHITECTURE.md, "Through a rank
-/// drop").
+/// energy to 2e-4 J; with this fraction, 6e-4 J
+/// (docs/decisions/0036-through-a-rank-drop.md).
 const KAPPA_REDUNDANT: f64 = 1e-6;
 
 /// Rows from which the maps are applied by a sparse factor instead of formed densely

@@ -1,4 +1,4 @@
-//! Contacts inside a simulation (math-spec §7.6, Algorithm I): event location of gap
+//! Contacts inside a simulation (docs/theory.md §impacts-in-a-run, Algorithm I): event location of gap
 //! closings on the integrator's dense output, the impulse solve at each event with the
 //! sequential law for simultaneous contacts, resting contact when impacts accumulate,
 //! and its release when its normal force changes sign.
@@ -15,7 +15,7 @@
 //! **Simultaneous contacts: the sequential law.** At an event, among the closed
 //! contacts (gap within [`GAP_FRACTION`] of the size of `q`) the one approaching fastest
 //! strikes alone (Newton restitution on that contact, every other contact free,
-//! math-spec E41 with one contact row), and the pass repeats until no closed contact
+//! docs/theory.md E41 with one contact row), and the pass repeats until no closed contact
 //! approaches. Newton's cradle with `e = 1` and equal masses then passes the impulse
 //! down the row: one ball in, one ball out. Each strike is one [`Impact`].
 //!

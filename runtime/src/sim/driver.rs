@@ -320,7 +320,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     // Adams evaluates about twice per step, last at the state it keeps, where the
     // projections read C next: C with the terms there costs less than a call of its
     // own per step. The explicit pairs evaluate 6 to 16 times per step, Radau5 at its
-    // stages: C at each costs more than the one call it saves (ARCHITECTURE.md).
+    // stages: C at each costs more than the one call it saves
+    // (docs/decisions/0018-c-and-cq-in-one-call.md).
     sys.point.constraints_with_terms = matches!(sim.method, Method::Adams);
     let pq: Vec<(&str, f64)> = sim
         .prescribed_q
@@ -474,7 +475,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
 
     // Projection with an explicit pair: the next step starts from the projected state
     // with the FSAL derivative of the unprojected one, as Adams keeps its differences
-    // (ARCHITECTURE.md, "the FSAL derivative survives the projection"): the
+    // (docs/decisions/0024-fsal-derivative-survives-the-projection.md): the
     // projection moves the state by about the local error, so the derivative's error
     // enters the next step multiplied by h, below the local error of the method.
     let keeps_fsal = sim.formulation == Formulation::Projection
@@ -536,8 +537,9 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Err(e) => {
                 let kind = failure(e, &mut rec.sys);
                 // An accepted state next to a rank drop of C_q from which every
-                // attempt fails the dropped rows' check (ARCHITECTURE.md, "Through a
-                // rank drop"): the step that reached it is taken back and redone
+                // attempt fails the dropped rows' check
+                // (docs/decisions/0036-through-a-rank-drop.md): the step that reached it is
+                // taken back and redone
                 // from where it started with half its size, a few times at most. Not
                 // with contacts, whose resting set and anchors follow the steps.
                 if steps_back

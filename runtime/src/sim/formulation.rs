@@ -110,7 +110,7 @@ pub(crate) trait Form {
 /// first-order bound of the dropped rows' residual assumes consistent positions), is
 /// rejected like a failed Newton iteration, and a shorter step brings the stage back;
 /// a genuinely inconsistent set fails every retry and ends the run with the typed error
-/// (ARCHITECTURE.md, "Through a rank drop").
+/// (docs/decisions/0036-through-a-rank-drop.md).
 fn inconsistent_redundant(e: &SimErrorKind) -> bool {
     matches!(
         e,

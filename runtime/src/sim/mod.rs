@@ -6,12 +6,12 @@
 //! or a [`SimError`] that keeps the partial run.
 //!
 //! # Formulations
-//! With $J = [C_q; G]$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (math-spec §4–§5), the
+//! With $J = [C_q; G]$ and $\gamma = [\gamma_h; \gamma_{nh}]$ (docs/theory.md §constraints), the
 //! accelerations come from the augmented system (E31)
 //! $$\begin{bmatrix}M & J^\mathsf{T}\\ J & 0\end{bmatrix}
 //!   \begin{bmatrix}\ddot q\\ \lambda\end{bmatrix} =
 //!   \begin{bmatrix}Q\\ \gamma\end{bmatrix}.$$
-//! - [`Formulation::Partitioning`] (math-spec Algorithm D in local coordinates): the
+//! - [`Formulation::Partitioning`] (docs/theory.md Algorithm D in local coordinates): the
 //!   integrator carries $y = [q; \dot q]$, but the right-hand side is a function of
 //!   independent coordinates only. At each evaluation $y$ is moved onto the manifold
 //!   in the *chart* of the last accepted state $q_a$: the dependent coordinates are the
@@ -31,7 +31,7 @@
 //!   (another intersection of the normal space with the manifold), is a recoverable
 //!   failure: the integrator rejects the attempt and retries a quarter of the step.
 //!   The choice of this chart over a partition of the coordinates themselves, with the
-//!   measurements behind it, is explained in `ARCHITECTURE.md`.
+//!   measurements behind it, is in `docs/decisions/0021-partitioning-in-a-local-chart.md`.
 //! - [`Formulation::Projection`]: index 1 on $y = [q; \dot q]$; after every accepted
 //!   step $q$ is projected onto $C(q,t) = 0$ and $\dot q$ onto $J\dot q + [C_t; g] = 0$,
 //!   handed back with [`Integrator::set_state`](crate::ode::Integrator::set_state).
@@ -43,8 +43,7 @@
 //!   $\Delta q = -C_q^\mathsf{T}(C_qC_q^\mathsf{T})^{-1}C$ and
 //!   $\dot q \leftarrow \dot q - J^\mathsf{T}(JJ^\mathsf{T})^{-1}(J\dot q + [C_t; g])$,
 //!   dense in $m$. Either meets $C$ to the Newton tolerance and the velocity
-//!   constraints to round-off (`ARCHITECTURE.md`, "Decision: the projection in the
-//!   metric of the mass matrix").
+//!   constraints to round-off (`docs/decisions/0034-projection-in-the-mass-metric.md`).
 //! - [`Formulation::Baumgarte`]: index 1 on $y = [q; \dot q]$ with
 //!   $\gamma_h \leftarrow \gamma_h - 2\alpha(C_q\dot q + C_t) - \beta^2 C$ and
 //!   $\gamma_{nh} \leftarrow \gamma_{nh} - 2\alpha(G\dot q + g)$, so that the
@@ -54,9 +53,9 @@
 //!   (critical damping, time constant 0.1 s; choose them a few times faster than the
 //!   motion of interest and slower than what the step size can resolve).
 //! - [`Formulation::Unconstrained`]: Lagrange's equations of the second kind in all
-//!   coordinates, $M\ddot q = Q$, without multipliers (math-spec (S2-22)): the
+//!   coordinates, $M\ddot q = Q$, without multipliers (docs/theory.md (S2-22)): the
 //!   constraints are not enforced. When the applied forces make the motion free
-//!   (math-spec §8) they hold by themselves, and the monitors measure how well. The
+//!   (docs/theory.md §redundant-coordinates) they hold by themselves, and the monitors measure how well. The
 //!   initial state is taken as given (prescriptions are written into it, nothing is
 //!   assembled); $M$ is factored densely.
 //!
@@ -153,11 +152,11 @@ pub fn min_step(t0: f64, t_end: f64) -> f64 {
 /// How the constrained equations become an ODE (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Formulation {
-    /// Coordinate partitioning, math-spec Algorithm D.
+    /// Coordinate partitioning, docs/theory.md Algorithm D.
     Partitioning,
     /// Index 1 with projection of positions and velocities after each step.
     Projection,
-    /// $M\ddot q = Q$ in all coordinates, without multipliers (math-spec (S2-22)).
+    /// $M\ddot q = Q$ in all coordinates, without multipliers (docs/theory.md (S2-22)).
     Unconstrained,
     /// Index 1 with Baumgarte stabilization.
     Baumgarte {

@@ -213,8 +213,8 @@ pub(crate) struct Point<'a, M: Mechanism + ?Sized> {
     /// (when not held): set for an integrator whose last evaluation of a step is at
     /// the state the step keeps (Adams' final evaluation), where the position group
     /// of the projections reads $C$ next, for a few operations on the sines the terms
-    /// already have instead of a call of its own (see ARCHITECTURE.md, "C in the
-    /// dynamics terms only where it is read").
+    /// already have instead of a call of its own (see
+    /// `docs/decisions/0018-c-and-cq-in-one-call.md`).
     pub constraints_with_terms: bool,
     /// $C$ with the next evaluation of the dynamics terms only (then cleared): set
     /// before the evaluation at the state a step ends in, where the projections and the
@@ -1104,7 +1104,8 @@ impl<'a, M: Mechanism + ?Sized> Point<'a, M> {
         }
         // Velocities: one update with J at the corrected positions is exact but for the
         // rounding of the solve (pivots at least 1e-8 of their diagonals). It is not
-        // checked here: a check cost 4–8 % of a run and never fired (ARCHITECTURE.md),
+        // checked here: a check cost 4–8 % of a run and never fired
+        // (docs/decisions/0034-projection-in-the-mass-metric.md),
         // and the monitors evaluate the velocity residuals at every kept state anyway
         // (`Run::monitors`, the largest velocity violation).
         self.velocity_residuals(t).map_err(eval)?;

@@ -27,7 +27,7 @@ use super::reference::Reference;
 use super::sweep;
 use super::util::{dense, max_abs, Rng};
 
-/// The consistent initial values of benchmark-models.md (to double precision).
+/// The consistent initial values of docs/models.md (to double precision).
 const Q0: [f64; 7] = [
     -0.061_713_890_014_276_45,
     0.0,
@@ -40,7 +40,7 @@ const Q0: [f64; 7] = [
 
 macro_rules! reference_parameters {
     ($($field:ident),* $(,)?) => {
-        /// The parameters of the reference formulation (benchmark-models.md).
+        /// The parameters of the reference formulation (docs/models.md).
         #[derive(Clone, Copy, Debug)]
         struct Hw {
             $($field: f64,)*
@@ -60,7 +60,7 @@ reference_parameters!(
 );
 
 impl Hw {
-    /// The mass matrix of benchmark-models.md (Hairer & Wanner's M).
+    /// The mass matrix of docs/models.md (Hairer & Wanner's M).
     #[allow(clippy::similar_names)]
     fn mass(&self, q: &[f64]) -> [[f64; 7]; 7] {
         let Hw {
@@ -183,7 +183,7 @@ impl Hw {
         (f, scale)
     }
 
-    /// The six loop-closure constraints of benchmark-models.md.
+    /// The six loop-closure constraints of docs/models.md.
     fn constraints(&self, q: &[f64]) -> [f64; 6] {
         let Hw {
             xa,
@@ -214,7 +214,7 @@ impl Hw {
 }
 
 /// The expressions of `models/src/andrews.rs`, re-typed: T = ½ q̇ᵀMq̇ with the M of
-/// benchmark-models.md, the motor torque on β, the spring as the virtual work
+/// docs/models.md, the motor torque on β, the spring as the virtual work
 /// −c0 (L − l0) δL, and the six constraints.
 fn reference(p: &Params) -> Reference {
     let hw = Hw::new(p);
@@ -310,7 +310,7 @@ fn info() {
             qd0: &[0.0; 7],
         },
     );
-    // The non-zero entries of M listed in benchmark-models.md, both triangles.
+    // The non-zero entries of M listed in docs/models.md, both triangles.
     let mass: &[(u32, u32)] = &[
         (0, 0),
         (0, 1),
@@ -412,7 +412,7 @@ fn matches_hairer_wanner() {
     println!("andrews vs Hairer & Wanner: M {worst_m:.1e}, f {worst_f:.1e} (tol {TOL:.0e})");
 }
 
-/// The default state is the consistent one of benchmark-models.md: |C| at rounding level
+/// The default state is the consistent one of docs/models.md: |C| at rounding level
 /// (the lengths are ~5e-2 m, so a few ulps are ~1e-17 m; 1e-15 leaves a factor ~100).
 #[test]
 fn initial_state_is_consistent() {

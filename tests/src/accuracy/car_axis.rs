@@ -1,4 +1,4 @@
-//! `car_axis` (benchmark-models.md; Rentrop, Roche & Steinebach 1989) against its
+//! `car_axis` (docs/models.md; Rentrop, Roche & Steinebach 1989) against its
 //! source expressions.
 
 use pfaff::TimeDependence;

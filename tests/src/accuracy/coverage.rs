@@ -4,7 +4,7 @@
 //! virtual work with several variations, nested intermediate definitions, integer
 //! literals, and every function of the description language.
 //!
-//! `v5` is case V5 of math-spec §10, so its generated functions must also reproduce the
+//! `v5` is case V5 of docs/theory.md §verification, so its generated functions must also reproduce the
 //! published A, h, c, λ and q̈.
 
 use std::f64::consts::PI;
@@ -16,7 +16,7 @@ use super::reference::Reference;
 use super::sweep;
 use super::util::{dense, max_abs, max_diff, solve};
 
-/// Math-spec V5: all terms of the multiplier formula active; with the linearization
+/// docs/theory.md V5: all terms of the multiplier formula active; with the linearization
 /// Jacobian, whose explicit time dependence and non-diagonal mass matrix it exercises.
 #[pfaff::mechanism(linearize)]
 pub mod v5 {
@@ -65,7 +65,7 @@ pub mod v5 {
     }
 }
 
-/// The expressions of `v5`, re-typed (math-spec V5).
+/// The expressions of `v5`, re-typed (docs/theory.md V5).
 fn reference_v5() -> Reference {
     Reference::new(3, |t, q, v| {
         0.5 * ((1.0 + q[1].powi(2)) * v[0].powi(2)
@@ -280,9 +280,9 @@ fn derivatives_constructs() {
     );
 }
 
-/// Math-spec V5 at t = 0.7, q = (0.3, −0.2, 0.5), q̇ = (0.1, 0.4, −0.3): A = M, h = Q,
+/// docs/theory.md V5 at t = 0.7, q = (0.3, −0.2, 0.5), q̇ = (0.1, 0.4, −0.3): A = M, h = Q,
 /// c = −γ_h, and the solution of M q̈ + C_qᵀλ = Q, C_q q̈ = γ_h gives q̈ and
-/// λ = −λ^[S2]; 1e-9 relative (the math-spec tolerance; the table has 12 digits).
+/// λ = −λ^[S2]; 1e-9 relative (docs/theory.md §verification; the table has 12 digits).
 #[test]
 #[allow(non_snake_case)]
 fn v5_multipliers() {

@@ -1,4 +1,4 @@
-//! `pendulum` (benchmark-models.md, IFToMM A01) against its source expressions.
+//! `pendulum` (docs/models.md, IFToMM A01) against its source expressions.
 
 use pfaff::TimeDependence;
 use pfaff_models::pendulum::{Model, Params, INFO};

@@ -1,8 +1,8 @@
 //! Hand-written reference of a model: its source expressions re-typed as closures over
 //! `f64`, and every generated quantity derived from them by central differences.
 //!
-//! The derivations follow the definitions of `runtime/src/mechanism.rs` and math-spec
-//! §4 and §8.4: $M = \partial^2T/\partial\dot q^2$;
+//! The derivations follow the definitions of `runtime/src/mechanism.rs` and docs/theory.md
+//! §constraints and §redundant-coordinates: $M = \partial^2T/\partial\dot q^2$;
 //! $Q = Q_e - \partial V/\partial q + \partial T/\partial q - T_{\dot qq}\dot q - T_{\dot qt}$;
 //! $\gamma_h = -(C_q\dot q)_q\dot q - 2C_{qt}\dot q - C_{tt}$;
 //! $\gamma_{nh} = -[(G\dot q)_q\dot q + G_t\dot q + g_q\dot q + g_t]$. The last three are

@@ -1,8 +1,8 @@
-//! The two examples of Chen, Wu & Mei (2016) (math-spec §8.8, V1–V4): the models
+//! The two examples of Chen, Wu & Mei (2016) (docs/theory.md §free-motion-examples, V1–V4): the models
 //! against their source expressions, and the multipliers of V1–V4 computed from the
 //! generated functions.
 //!
-//! With the sign of math-spec (E0), $M\ddot q + C_q^\mathsf{T}\lambda = Q$ and
+//! With the sign of docs/theory.md (E0), $M\ddot q + C_q^\mathsf{T}\lambda = Q$ and
 //! $C_q\ddot q = \gamma_h$ give, for one constraint with row $c = C_q$,
 //! $\lambda = (c M^{-1} Q - \gamma_h)/(c M^{-1} c^\mathsf{T})$, and $\lambda^{[S2]} = -\lambda$.
 
@@ -114,7 +114,7 @@ fn derivatives_example2() {
     );
 }
 
-/// The multiplier λ of math-spec (E0) from the generated M, Q, C_q, γ_h, with the
+/// The multiplier λ of docs/theory.md (E0) from the generated M, Q, C_q, γ_h, with the
 /// applied force `applied` on q2 taken out of Q; returns (λ, the size of the terms).
 fn multiplier(model: &dyn Mechanism, s: &State, applied: f64) -> (f64, f64) {
     let info = model.info();
@@ -138,7 +138,7 @@ fn multiplier(model: &dyn Mechanism, s: &State, applied: f64) -> (f64, f64) {
 
 /// V1 and V3: with Q = 0 the [S2] multipliers are −1/14 (example 1 at t = 1, q̇1 = 0.5,
 /// any q, q̇2, q̇3) and −1.66030661896282 (example 2 at t = 1, q1 = 1, q̇1 = 0.5).
-/// math-spec tolerance for algebraic results: 1e-9 relative.
+/// docs/theory.md §verification, tolerance for algebraic results: 1e-9 relative.
 #[test]
 fn v1_v3_multipliers() {
     let mut rng = Rng::new(0x5eed_0007);

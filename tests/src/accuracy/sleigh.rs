@@ -1,4 +1,4 @@
-//! `sleigh` (benchmark-models.md, math-spec V11) against its source expressions.
+//! `sleigh` (docs/models.md, docs/theory.md V11) against its source expressions.
 
 use pfaff::TimeDependence;
 use pfaff_models::sleigh::{Model, Params, INFO};

@@ -1,4 +1,4 @@
-//! `slider_crank` (math-spec V10) against its source expressions, and the kinematics of
+//! `slider_crank` (docs/theory.md V10) against its source expressions, and the kinematics of
 //! the V10 table computed from the generated functions.
 
 use std::f64::consts::PI;
@@ -12,7 +12,7 @@ use super::sweep;
 use super::util::{dense, max_abs, max_diff, solve};
 
 /// The V10 configuration at t = 0 (φ2 = −arcsin(1/6)), q and q̇, to double precision
-/// (the table of math-spec V10 gives them to 12 digits).
+/// (the table of docs/theory.md V10 gives them to 12 digits).
 const Q0: [f64; 9] = [
     0.043_301_270_189_221_93,
     0.025,
@@ -135,9 +135,9 @@ fn derivatives() {
     );
 }
 
-/// Math-spec V10 at t = 0: the default state satisfies the constraints at position and
+/// docs/theory.md V10 at t = 0: the default state satisfies the constraints at position and
 /// velocity level, and the velocities and accelerations solved from the generated
-/// `C_q q̇ = −C_t`, `C_q q̈ = γ_h` reproduce the table (1e-9 relative, the math-spec
+/// `C_q q̇ = −C_t`, `C_q q̈ = γ_h` reproduce the table (1e-9 relative, the docs/theory.md
 /// tolerance for algebraic results; the table has 12 decimals).
 #[test]
 fn v10_kinematics() {
@@ -158,7 +158,7 @@ fn v10_kinematics() {
     model.holonomic_gamma(0.0, &q, &velocity, &mut gamma);
     let acceleration = solve(&cq, &gamma);
 
-    // math-spec V10 table.
+    // docs/theory.md V10 table.
     let table_qd = [
         -0.25,
         0.433_012_701_892,

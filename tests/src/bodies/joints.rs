@@ -190,7 +190,8 @@ fn spatial_joints_and_forces_against_finite_differences() {
 
 /// The built-in spatial models, whose frames carry their angular velocities and origin
 /// velocities down the frame tree and whose rolling wheels read `C_q` and `γ_h` from
-/// the contact point's velocity (ARCHITECTURE.md, "The body level"): the same checks.
+/// the contact point's velocity
+/// (docs/decisions/0007-kinematics-down-the-frame-tree.md): the same checks.
 #[test]
 fn built_in_spatial_models_against_finite_differences() {
     use pfaff_models::{bicycle, bricard, chain10, free_body, rolling_disk, spatial_four_bar};

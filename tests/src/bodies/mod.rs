@@ -1,5 +1,5 @@
 //! The body level of `#[mechanism]`: agreement with hand-written models, the Euler-parameter
-//! free body (math-spec V12), and every joint type against finite differences.
+//! free body (docs/theory.md V12), and every joint type against finite differences.
 
 mod bricard;
 mod chain;
@@ -68,9 +68,9 @@ fn slider_crank_from_bodies_equals_the_hand_written_model() {
     assert!(worst < 1e-10, "largest difference along the run {worst:e}");
 }
 
-/// Math-spec V12: the torque-free body with Ī = diag(1, 1, 2) and ω̄(0) = (1, 0, 2) keeps
+/// docs/theory.md V12: the torque-free body with Ī = diag(1, 1, 2) and ω̄(0) = (1, 0, 2) keeps
 /// T = 4.5 and the global angular momentum A Ī ω̄ = (1, 0, 4) over 100 s with θᵀθ = 1,
-/// and ω̄(t) = (cos 2t, sin 2t, 2) (closed form of the symmetric top, math-spec V12).
+/// and ω̄(t) = (cos 2t, sin 2t, 2) (closed form of the symmetric top, docs/theory.md V12).
 #[test]
 fn free_body_keeps_energy_and_angular_momentum_v12() {
     let model = free_body::Model::default();

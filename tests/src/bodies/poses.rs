@@ -6,11 +6,11 @@ use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff::{Mechanism, PoseExt};
 use pfaff_models::{free_body, slider_crank_bodies};
 
-/// The free body (math-spec V12) along 10 s: every pose's rotation is orthonormal with
+/// The free body (docs/theory.md V12) along 10 s: every pose's rotation is orthonormal with
 /// determinant 1 and equals the raw matrix of `frame_poses` to round-off; the pose's
 /// translation is the raw origin; the quaternion is a unit quaternion equal (up to sign)
 /// to the Euler parameters `(e0, e1, e2, e3)`, which are the quaternion of the rotation
-/// `A(θ)` by definition (math-spec E1); planar poses are refused for a spatial frame.
+/// `A(θ)` by definition (docs/theory.md E1); planar poses are refused for a spatial frame.
 #[test]
 fn spatial_poses_agree_with_the_raw_slices_and_the_euler_parameters() {
     let model = free_body::Model::default();

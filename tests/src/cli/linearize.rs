@@ -84,7 +84,7 @@ fn pendulum_upright() {
 /// The Chaplygin sleigh running straight along x at speed v (φ = 0, φ̇ = 0).
 ///
 /// With the forward speed u and the turning rate ω of the body,
-/// $\dot u = a\omega^2$ and $(i_c + m a^2)\dot\omega = -m a u\omega$ (math-spec V11).
+/// $\dot u = a\omega^2$ and $(i_c + m a^2)\dot\omega = -m a u\omega$ (docs/theory.md V11).
 /// At φ = 0, Algorithm P makes ẏ dependent, so the reduced state is (y, x, φ, ẋ, φ̇)
 /// and ẋ = u, φ̇ = ω there. The velocity rows do not depend on x, y (cyclic) nor, at
 /// ω = 0, on φ, so dropping x, y, φ removes three zero eigenvalues and leaves

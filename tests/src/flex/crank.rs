@@ -1,5 +1,5 @@
 //! `flexible_crank` against the equations of the Test Set for IVP Solvers ("crank",
-//! Simeon's slider crank with an elastic connecting rod) as benchmark-models.md
+//! Simeon's slider crank with an elastic connecting rod) as docs/models.md
 //! transcribes them; the run to t = 0.1 with RADAU5; the rigid limit.
 
 use pfaff::sim::{Formulation, Method, Run, Simulation};
@@ -9,7 +9,7 @@ use pfaff_models::{flexible_crank, flexible_crank_shapes};
 use super::models::rigid_crank;
 use super::{max_abs, max_diff, Rng};
 
-/// The test set's data (benchmark-models.md, "flexible_crank"), π written 3.1415927.
+/// The test set's data (docs/models.md, "flexible_crank"), π written 3.1415927.
 struct TestSet {
     m1: f64,
     m2: f64,
@@ -30,7 +30,7 @@ struct TestSet {
 }
 
 fn test_set(grav: f64) -> TestSet {
-    // The test set's rounded π, on purpose (benchmark-models.md).
+    // The test set's rounded π, on purpose (docs/models.md).
     #[allow(clippy::approx_constant)]
     let pi = 3.1415927;
     test_set_with(grav, pi, 15.0)
@@ -39,7 +39,7 @@ fn test_set(grav: f64) -> TestSet {
 /// The closed-form integrals of the rod's shape functions (ξ = x/l2, lateral
 /// `sin πξ, sin 2πξ`, axial `4ξ(1−ξ), 2ξ² − ξ`), by hand: `∫ sin² kπξ = ½`;
 /// `∫ (4ξ(1−ξ))² = 8/15`, `∫ 4ξ(1−ξ)(2ξ²−ξ) = 1/15`, `∫ (2ξ²−ξ)² = 2/15` (the test
-/// set's 8, 1, 2 are 15 times these: benchmark-models.md); `∫ 4ξ(1−ξ) = 2/3`,
+/// set's 8, 1, 2 are 15 times these: docs/models.md); `∫ 4ξ(1−ξ) = 2/3`,
 /// `∫ (2ξ²−ξ) = 1/6`, `∫ sin πξ = 2/π`, `∫ ξ·4ξ(1−ξ) = 1/3`, `∫ ξ(2ξ²−ξ) = 1/6`,
 /// `∫ ξ sin πξ = 1/π`, `∫ ξ sin 2πξ = −1/(2π)`, `∫ sin πξ · 4ξ(1−ξ) = 16/π³`,
 /// `∫ sin πξ (2ξ²−ξ) = 1/π − 8/π³`, `∫ sin 2πξ (2ξ²−ξ) = 1/(2π)`, `∫ sin 2πξ · 4ξ(1−ξ) = 0`;
@@ -202,7 +202,7 @@ fn crank_state(rng: &mut Rng) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// The generated mass matrix, forces and constraints equal the test set's `AM`, `F` and
-/// constraints (benchmark-models.md) at random states to 1e-12 (relative to the largest
+/// constraints (docs/models.md) at random states to 1e-12 (relative to the largest
 /// entry), with gravity off (the test set's value) and on.
 #[test]
 fn generated_equations_equal_the_test_set() {
@@ -244,7 +244,7 @@ fn generated_equations_equal_the_test_set() {
 /// `flexible_crank_shapes`, whose rod is integrated from its shape functions at compile
 /// time: its mass matrix and forces equal the test set's formulas with the closed-form
 /// integrals of [`closed_form`] at random states to 1e-12, and its modal mass's axial
-/// block is exactly 1/15 of `flexible_crank`'s (benchmark-models.md), the rest of `M`
+/// block is exactly 1/15 of `flexible_crank`'s (docs/models.md), the rest of `M`
 /// equal to the rounding of the test set's π.
 #[test]
 fn integrated_invariants_equal_the_closed_form_integrals() {

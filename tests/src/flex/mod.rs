@@ -1,7 +1,7 @@
-//! Deformable bodies in the floating frame of reference (math-spec §2–§3): the property
+//! Deformable bodies in the floating frame of reference (docs/theory.md §floating-frame): the property
 //! tests V6 (planar) and V7 (spatial) against the kinetic energy integrated independently
 //! here and against E13/E14, Simeon's slider crank with an elastic rod against the test
-//! set's own equations (benchmark-models.md), and the rigid limit.
+//! set's own equations (docs/models.md), and the rigid limit.
 
 mod crank;
 mod models;

@@ -1,9 +1,9 @@
-//! Deformable bodies for the property tests V6 and V7 of math-spec §10 and for the rigid
+//! Deformable bodies for the property tests V6 and V7 of docs/theory.md §verification and for the rigid
 //! limit. Their states need not be consistent: the tests compare quantities at random
 //! states.
 
-/// V6: a free planar frame carrying the two-node Euler–Bernoulli element of math-spec
-/// §3.7 (E18) with its six nodal coordinates, integrated from its shape functions; the
+/// V6: a free planar frame carrying the two-node Euler–Bernoulli element of docs/theory.md
+/// §beam-elements (E18) with its six nodal coordinates, integrated from its shape functions; the
 /// centre line is offset by `off` from the frame's x axis, so that every invariant of
 /// E10 is non-zero. No stiffness: the forces are `Q_v`.
 #[pfaff::mechanism]

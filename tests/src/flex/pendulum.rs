@@ -1,4 +1,4 @@
-//! `flexible_pendulum`: a bar of spatial beam elements (math-spec E20, §3.8) on a ball
+//! `flexible_pendulum`: a bar of spatial beam elements (docs/theory.md E20, §beam-elements) on a ball
 //! joint, Euler parameters, gravity. Checked against closed forms: the clamped-free and
 //! pinned-free bending frequencies of the Euler–Bernoulli beam, energy conservation, the
 //! rigid physical pendulum's period as the bar stiffens, and the generated forces against

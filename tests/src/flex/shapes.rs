@@ -1,4 +1,4 @@
-//! Math-spec V6 and V7: the mass matrix and the quadratic-velocity vector that the
+//! docs/theory.md V6 and V7: the mass matrix and the quadratic-velocity vector that the
 //! generator derives for a deformable body integrated from its shape functions, against
 //! the kinetic energy `T = ½ ∫ρ ṙ·ṙ` integrated here by quadrature (E9), against the
 //! closed forms E13/E14 with the invariants E10 integrated here, and against
@@ -19,7 +19,7 @@ struct Material {
     rho: fn(f64) -> f64,
 }
 
-/// The §3.7 element as in `planar_element` (l = 0.7, ρA = 2.5, centre line offset 0.05).
+/// The planar beam element (docs/theory.md §beam-elements) as in `planar_element` (l = 0.7, ρA = 2.5, centre line offset 0.05).
 fn element() -> Material {
     const L: f64 = 0.7;
     Material {
@@ -78,7 +78,7 @@ fn mat_vec(a: &[f64], cols: usize, v: &[f64]) -> Vec<f64> {
 
 /// The rotation and, applied to a body-frame vector `u`, the velocity term: planar
 /// `Ȧu = θ̇ A Ĩ u`; spatial `A (ω̄ × u)` with `ω̄ = Ḡ θ̇ = 2 Ē θ̇` (E3–E6, the form of
-/// math-spec §3 whose mass matrix and `Q_v` E12/E15 are).
+/// docs/theory.md §floating-frame whose mass matrix and `Q_v` E12/E15 are).
 fn rotation(dim: usize, q: &[f64], qd: &[f64]) -> (Vec<f64>, Vec<f64>) {
     if dim == 2 {
         let (s, c) = q[2].sin_cos();
@@ -203,7 +203,7 @@ fn invariants(b: &Material) -> Invariants {
     }
 }
 
-/// Math-spec V6 with the §3.7 element: the generated `M` equals the Hessian of the
+/// docs/theory.md V6 with the planar beam element: the generated `M` equals the Hessian of the
 /// quadrature's `T` and E13, the generated `Q_v` equals `∂T/∂q − Ṁq̇` and E14 in every
 /// row, including the sign of the Coriolis term `−2θ̇(S̄₂₁ − S̄₁₂)q̇_f`.
 #[test]
@@ -358,8 +358,8 @@ fn inv_mass(b: &Material) -> f64 {
     quad(&mut |x| (b.rho)(x))
 }
 
-/// Math-spec V6, third item: the generated body reproduces the element integrals of
-/// §3.7, `∫ρA S dx` (through `M_Rf = A S̄` at θ = 0) and `∫ρA SᵀĨS dx = S̄₂₁ − S̄₁₂`
+/// docs/theory.md V6, third item: the generated body reproduces the element integrals of
+/// docs/theory.md §beam-elements, `∫ρA S dx` (through `M_Rf = A S̄` at θ = 0) and `∫ρA SᵀĨS dx = S̄₂₁ − S̄₁₂`
 /// (through the Coriolis part of `Q_v^f = −2θ̇(S̄₂₁ − S̄₁₂)q̇_f`).
 #[test]
 fn element_shape_integrals_of_section_3_7() {
@@ -379,7 +379,7 @@ fn element_shape_integrals_of_section_3_7() {
             assert!((m[r * n + 3 + j] - want).abs() < 1e-14, "S̄[{r},{j}]");
         }
     }
-    // ρAl/420 · (the matrix of §3.7)
+    // ρAl/420 · (the planar element's matrix)
     let sis = [
         [0.0, -147.0, -21.0 * l, 0.0, -63.0, 14.0 * l],
         [147.0, 0.0, 0.0, 63.0, 0.0, 0.0],
@@ -408,7 +408,7 @@ fn element_shape_integrals_of_section_3_7() {
     }
 }
 
-/// Math-spec V7: unit θ, θ̇ ⊥ θ. The generated `M` equals the Hessian of the quadrature's
+/// docs/theory.md V7: unit θ, θ̇ ⊥ θ. The generated `M` equals the Hessian of the quadrature's
 /// `T` on such velocities; `Q_v` equals the quadrature's `∂T/∂q − Ṁq̇` in the R and f
 /// rows, and in the θ rows up to a multiple of θ (parallelism tested, not the multiple).
 #[test]
@@ -468,7 +468,7 @@ fn spatial_mass_matrix_and_quadratic_velocity_vector_v7() {
 }
 
 /// The generated `Q_v` is `∂T/∂q − Ṁq̇` of the generated `T` and `M` (the self-check
-/// of math-spec §0), by central differences of `kinetic_energy` and `mass_matrix`, for
+/// of docs/theory.md §scope), by central differences of `kinetic_energy` and `mass_matrix`, for
 /// both bodies at states off the constraint (any θ, θ̇).
 #[test]
 fn quadratic_velocity_vector_is_the_lagrange_derivative_of_the_generated_energy() {

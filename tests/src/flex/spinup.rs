@@ -1,4 +1,4 @@
-//! `spinup_beam` (Kane, Ryan & Banerjee 1987; benchmark-models.md): with geometric
+//! `spinup_beam` (Kane, Ryan & Banerjee 1987; docs/models.md): with geometric
 //! stiffening the tip deflection stays bounded over [0, 20] s and oscillates about zero
 //! after the spin-up; the linear floating-frame model without it diverges once the spin
 //! rate passes the first bending frequency (the run ends with a typed error keeping the
@@ -163,7 +163,7 @@ fn element_spinup_keeps_the_first_axial_mode() {
 /// the rotating cantilever's ω² = ω₀² + (K − 1)Ω² with Southwell's coefficient
 /// K = 1.1933 of the first mode (uniform beam, hub radius 0: the Rayleigh quotient
 /// ∫½(1 − ξ²)φ'²/∫φ² of the clamped-free mode, evaluated here; first order in Ω²),
-/// ω₀ = 3.7977 rad/s (benchmark-models.md); at Ω = 6 rad/s, where the first-order
+/// ω₀ = 3.7977 rad/s (docs/models.md); at Ω = 6 rad/s, where the first-order
 /// formula no longer holds, they agree with each other. Without stiffening the
 /// rotation softens the beam, ω² = ω₀² − Ω² < 0 at 6 rad/s: the divergence.
 #[test]

@@ -1,4 +1,4 @@
-//! The inverse problems of math-spec §8.6 and §8.9 step 3: applied forces that make a
+//! The inverse problems of docs/theory.md §free-motion and §free-motion-analysis step 3: applied forces that make a
 //! motion free (minimum norm, would-be constraint forces, chosen components, and the
 //! report when the components cannot do it), and the member of a family of constraints
 //! that makes it free.

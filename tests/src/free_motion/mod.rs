@@ -1,4 +1,4 @@
-//! Constraint reactions and free motion (math-spec §8, [S2]): V1–V5, the designed
+//! Constraint reactions and free motion (docs/theory.md §redundant-coordinates, [S2]): V1–V5, the designed
 //! forces and their simulation, the symbolic conditions the generator prints, the
 //! slider-crank reactions against Newton–Euler, and redundant constraints.
 //!

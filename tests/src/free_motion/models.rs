@@ -1,6 +1,6 @@
 //! Test mechanisms written with `#[pfaff::mechanism]`.
 
-/// V5 of math-spec §10 (defined with the accuracy tests, which check its generated
+/// V5 of docs/theory.md §verification (defined with the accuracy tests, which check its generated
 /// functions against the source expressions).
 pub use crate::accuracy::coverage::v5;
 

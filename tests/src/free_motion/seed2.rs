@@ -1,4 +1,4 @@
-//! V1–V4 of math-spec §10 with the library: the explicit multipliers of [S2]'s two
+//! V1–V4 of docs/theory.md §verification with the library: the explicit multipliers of [S2]'s two
 //! examples without applied forces (V1, V3), and their free motions (V2, V4) both as
 //! modelled and with the forces the analysis designs, simulated with multipliers.
 
@@ -12,7 +12,7 @@ use pfaff_models::{seed2_example1 as ex1, seed2_example2 as ex2};
 use super::sim::{samples, simulate};
 use super::{assert_close, designed, inf_norm};
 
-/// Solver tolerance of the simulations; math-spec: integrated results to 100 × that.
+/// Solver tolerance of the simulations; docs/theory.md §verification: integrated results to 100 × that.
 const TOL: f64 = 1e-12;
 
 fn explicit<M: Mechanism>(model: &M, t: f64, q: &[f64], qd: &[f64]) -> FreeMotionPoint {
@@ -127,7 +127,7 @@ fn v2_designed_forces_simulated() {
     );
 }
 
-/// V2 and V4 as modelled, integrated *without* multipliers ((S2-22), math-spec §8.9
+/// V2 and V4 as modelled, integrated *without* multipliers ((S2-22), docs/theory.md §free-motion-analysis
 /// step 4): the constraint and its rate stay at solver tolerance, V4 meets the
 /// published table, and the analysis finds the motions free.
 #[test]

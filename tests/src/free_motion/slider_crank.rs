@@ -1,7 +1,7 @@
 //! The reactions of `slider_crank` (absolute coordinates, so the multipliers are pin
 //! forces) against an independent Newton–Euler computation per body.
 //!
-//! Reading of the multipliers (sign of math-spec §1, constraint force $-J_k^\mathsf{T}
+//! Reading of the multipliers (sign of docs/theory.md §sign, constraint force $-J_k^\mathsf{T}
 //! \lambda_k$): at O the ground pushes the crank with $-(\lambda_{ox}, \lambda_{oy})$; at
 //! A the coupler pushes the crank with $-(\lambda_{ax}, \lambda_{ay})$ and the crank the
 //! coupler with the opposite; at B likewise between coupler and slider; the guide

@@ -1,4 +1,4 @@
-//! The free-motion conditions the generator emits (math-spec §8.9 step 1) for models
+//! The free-motion conditions the generator emits (docs/theory.md §free-motion-analysis step 1) for models
 //! with a diagonal or constant mass matrix: the printed formulas of [S2]'s examples, and
 //! the emitted residual against the numeric one of the runtime at random states.
 

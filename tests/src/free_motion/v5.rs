@@ -1,4 +1,4 @@
-//! V5 of math-spec §10: the general multiplier formula of [S2] with every term of $h$
+//! V5 of docs/theory.md §verification: the general multiplier formula of [S2] with every term of $h$
 //! active ($T_2$ with $\partial A/\partial q$ and $\partial A/\partial t$, $T_1$, $T_0$,
 //! rheonomic constraints, forces), against the published numbers and against the
 //! augmented solve.

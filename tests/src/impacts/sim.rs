@@ -1,4 +1,4 @@
-//! Impacts inside simulations (math-spec §7.6): event location, the jump, the restart,
+//! Impacts inside simulations (docs/theory.md §impacts-in-a-run): event location, the jump, the restart,
 //! accumulation into resting contact and its release, simultaneous contacts, and a
 //! singular impact as a typed error with the run kept. Closed forms are cited per test.
 
@@ -32,7 +32,7 @@ fn run(model: &dyn Mechanism, f: Formulation, m: Method, t_end: f64) -> Run {
 /// The bouncing ball (h = 1, e = 0.5, g = 9.81): impact n at
 /// t_n = T (1 + 2 Σ_{k<n} e^k) with T = √(2h/g), rebound speed e^n √(2gh) (so the
 /// rebound height is e^{2n} h), and the accumulation time T (1+e)/(1−e)
-/// (benchmark-models.md), after which the ball rests on the ground.
+/// (docs/models.md), after which the ball rests on the ground.
 #[test]
 fn bouncing_ball_impact_times_heights_and_accumulation() {
     let model = bouncing_ball::Model::default();
@@ -110,7 +110,7 @@ fn bouncing_ball_releases_under_an_upward_pull() {
     }
 }
 
-/// Falling rod (benchmark-models.md defaults): the lower end strikes at
+/// Falling rod (docs/models.md defaults): the lower end strikes at
 /// t* = (v − speed)/g with v = √(speed² + 2 g gap); then P = (1+e) m v / (1 + 3cos²φ),
 /// ẏ⁺ = −v + P/m, φ̇⁺ = −6 P cos φ/(m l).
 #[test]
@@ -187,7 +187,7 @@ fn contact_closed_at_the_start_is_an_impact_at_t0() {
 }
 
 /// The energy monitors of a run with impacts, one of them at t = 0 (`pendulum_floor`,
-/// math-spec V15): the initial energy is that of the state as given, before the jump
+/// docs/theory.md V15): the initial energy is that of the state as given, before the jump
 /// at t = 0; the impacts' losses are summed apart (their `energy_lost`, so
 /// E_final = E_initial − lost up to the integration's drift), and the drift excludes
 /// them.

@@ -1,5 +1,5 @@
-//! The impulse solve (math-spec §7.3, Algorithm I-solve) on the verification cases
-//! V13–V16 of math-spec §10: the augmented form (E41) and the partitioned form (E42)
+//! The impulse solve (docs/theory.md §impulse-solve, Algorithm I-solve) on the verification cases
+//! V13–V16 of docs/theory.md §verification: the augmented form (E41) and the partitioned form (E42)
 //! against the published numbers to 1e-9, and against each other.
 
 use pfaff::{Impact, ImpactError, ImpactSolver, Mechanism, MechanismExt};
@@ -227,7 +227,7 @@ fn v16_nonholonomic_constraint_and_the_jump_of_its_reaction() {
 
 /// Energy never increases across an impact, e = 1 conserves it, e = 0 leaves the
 /// contact at rest, and the loss is the effective-mass formula ½(1 − e²) m_eff v_n²
-/// (math-spec §7.3, with m_eff from the impulse: P = (1 + e) m_eff |v_n|).
+/// (docs/theory.md §impulse-solve, with m_eff from the impulse: P = (1 + e) m_eff |v_n|).
 #[test]
 fn energy_balance_over_random_impacts() {
     let mut rng = Rng::new(7);

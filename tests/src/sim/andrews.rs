@@ -60,14 +60,14 @@ fn partitioning_dop853_follows_the_reference_at_every_tolerance() {
     }
 }
 
-/// The consistent initial state of benchmark-models.md (`andrews`: seven angles to 30
+/// The consistent initial state of docs/models.md (`andrews`: seven angles to 30
 /// digits, all velocities zero) given in full is taken as it is: the first row is the
 /// given state, bit for bit.
 #[test]
 fn the_full_benchmark_state_is_accepted_as_given() {
     let model = andrews::Model::default();
     let names = ["beta", "theta", "gamma", "phi", "delta", "omega", "epsilon"];
-    #[allow(clippy::excessive_precision)] // the digits of benchmark-models.md
+    #[allow(clippy::excessive_precision)] // the digits of docs/models.md
     let values = [
         -0.061_713_890_014_276_449_635_894_845_800_1,
         0.0,

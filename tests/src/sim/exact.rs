@@ -1,5 +1,5 @@
 //! Closed-form references: the Jacobi elliptic functions by the AGM (descending Landen)
-//! method, the simple pendulum, and the Chaplygin sleigh of math-spec V11.
+//! method, the simple pendulum, and the Chaplygin sleigh of docs/theory.md V11.
 
 /// `(sn, cn, dn)(u | m)` for `0 ≤ m < 1` by the arithmetic-geometric mean, i.e. the
 /// descending Landen transformation: Abramowitz & Stegun, Handbook of Mathematical
@@ -34,12 +34,12 @@ pub fn jacobi(u: f64, m: f64) -> (f64, f64, f64) {
     (sn, phi.cos(), (1.0 - m * sn * sn).sqrt())
 }
 
-/// $K(1/2)$, benchmark-models.md (`pendulum`).
+/// $K(1/2)$, docs/models.md (`pendulum`).
 #[allow(clippy::excessive_precision)] // the digits as printed in the reference
 pub const K_HALF: f64 = 1.854_074_677_301_371_918_43;
 
 /// Exact state `(x, y, ẋ, ẏ)` of the `pendulum` model (l = 1, g = 9.81, released at
-/// rest at x = l, y = 0). benchmark-models.md: with θ from the downward vertical,
+/// rest at x = l, y = 0). docs/models.md: with θ from the downward vertical,
 /// $\sin(\theta/2) = k\,\operatorname{sn}(K - \omega_0 t \mid m = 1/2)$, $k = 1/\sqrt2$,
 /// $\omega_0 = \sqrt{g/l}$. Differentiating, with $\cos(\theta/2) = \operatorname{dn}$,
 /// $\dot\theta = -2k\omega_0\operatorname{cn}(K - \omega_0 t)$.
@@ -58,10 +58,10 @@ pub fn pendulum(t: f64) -> [f64; 4] {
     ]
 }
 
-/// The pendulum period $4K/\omega_0$ = 2.36784194757624 s (benchmark-models.md).
+/// The pendulum period $4K/\omega_0$ = 2.36784194757624 s (docs/models.md).
 pub const PENDULUM_PERIOD: f64 = 2.367_841_947_576_24;
 
-/// Math-spec V11 (Chaplygin sleigh, m = 2, J_c = 0.05, a = 0.3, v0 = 1, ω0 = 0.5):
+/// docs/theory.md V11 (Chaplygin sleigh, m = 2, J_c = 0.05, a = 0.3, v0 = 1, ω0 = 0.5):
 /// `(t, v, ω, φ)` from the table of expected values.
 pub const SLEIGH_V11: [(f64, f64, f64, f64); 3] = [
     (

@@ -1,8 +1,8 @@
 //! Simulation tests (`pfaff::sim`) on the built-in models and on a few models written
 //! for these tests with `#[pfaff::mechanism]`.
 //!
-//! Every reference value cites its source: math-spec.md (cases V10, V11),
-//! benchmark-models.md (the pendulum's exact solution), or a closed form derived in the
+//! Every reference value cites its source: docs/theory.md (cases V10, V11),
+//! docs/models.md (the pendulum's exact solution), or a closed form derived in the
 //! test.
 
 mod andrews;

@@ -1,7 +1,7 @@
 //! Models written for the simulation tests.
 #![allow(clippy::unreadable_literal)]
 
-/// The slider-crank of math-spec V10 without its driver: one degree of freedom, a
+/// The slider-crank of docs/theory.md V10 without its driver: one degree of freedom, a
 /// heavy crank (flywheel, `j1` = 10 kg m² against 1e-3 for the other bodies), no
 /// gravity, so it spins through both dead centres at an almost constant rate.
 #[pfaff::mechanism]
@@ -79,7 +79,7 @@ pub mod flywheel_crank {
     }
 }
 
-/// The slider-crank of math-spec V10 driven by its slider, $x_3 = x_{3,0} + v t$
+/// The slider-crank of docs/theory.md V10 driven by its slider, $x_3 = x_{3,0} + v t$
 /// (`v` = 0.1 m/s). The slider reaches the crank's reach $a + b = 0.4$ at
 /// $t^\ast = (0.4 - 0.38240652953342)/0.1 = 0.17593470466577$ s; past it the
 /// constraints have no solution.

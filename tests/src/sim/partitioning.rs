@@ -6,7 +6,7 @@ use pfaff_models::{andrews, pendulum};
 
 use super::exact;
 
-/// Three periods of the pendulum (benchmark-models.md: period 2.36784194757624 s).
+/// Three periods of the pendulum (docs/models.md: period 2.36784194757624 s).
 const T_END: f64 = 3.0 * exact::PENDULUM_PERIOD;
 
 /// The error floor of three periods in double precision: about 2000 steps at the
@@ -94,7 +94,8 @@ fn partitioned_error_is_within_three_times_the_projected_one() {
 /// (and of the polish of accepted states) average at most 2 per evaluation of the
 /// right-hand side, with every adaptive explicit method. Radau5 runs the chart to
 /// round-off instead of to its tolerance (its Jacobian is made of differences of the
-/// right-hand side, see ARCHITECTURE.md), which costs about one update more: at most 3.
+/// right-hand side, see docs/decisions/0026-implicit-integrator-radau5.md), which costs
+/// about one update more: at most 3.
 #[test]
 fn andrews_takes_at_most_two_newton_updates_per_evaluation() {
     let model = andrews::Model::default();
@@ -158,7 +159,7 @@ fn the_work_of_output_rows_is_counted_apart() {
 
 /// The pendulum to t = 1000 s (422 periods) at rtol = atol = 1e-12 with partitioning,
 /// with Adams (the command's default) and DOP853 (the library's default): the final
-/// position within 1e-7 of the closed form (benchmark-models.md; the exact solution at
+/// position within 1e-7 of the closed form (docs/models.md; the exact solution at
 /// t = 1000 is x = −0.683230188552, y = −0.730203060423 by mpmath's `ellipfun`, which
 /// `exact::pendulum` reproduces to 1e-12).
 #[test]

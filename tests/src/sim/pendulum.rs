@@ -1,4 +1,4 @@
-//! The `pendulum` model against its exact solution (benchmark-models.md), with every
+//! The `pendulum` model against its exact solution (docs/models.md), with every
 //! formulation and integrator; convergence orders and tolerance proportionality.
 
 use pfaff::sim::{Formulation, Method, Run, Simulation};
@@ -42,7 +42,7 @@ fn exact_solution_checks() {
     assert!((s * s + c * c - 1.0).abs() < 1e-15);
     assert!((d * d + 0.5 * s * s - 1.0).abs() < 1e-15);
     // The exact pendulum returns to its start after one period
-    // (benchmark-models.md: 2.36784194757624 s) and is at the bottom at a quarter.
+    // (docs/models.md: 2.36784194757624 s) and is at the bottom at a quarter.
     let e = exact::pendulum(exact::PENDULUM_PERIOD);
     assert!((e[0] - 1.0).abs() < 1e-12 && e[1].abs() < 1e-12, "{e:?}");
     let b = exact::pendulum(exact::PENDULUM_PERIOD / 4.0);
@@ -86,7 +86,7 @@ fn every_formulation_and_method_follows_the_exact_solution() {
                 run.stats.restarts,
             );
             assert_eq!(run.trajectory.len(), 61);
-            // Integrated results: solver tolerance × 100 (math-spec §10); RK4 with
+            // Integrated results: solver tolerance × 100 (docs/theory.md §verification); RK4 with
             // h = 1e-3 has a global error of order h⁴·ω⁴ ≈ 1e-10.
             let bound = 1e2;
             failures += usize::from(err >= bound * rtol);
@@ -113,7 +113,7 @@ fn every_formulation_and_method_follows_the_exact_solution() {
             }
         }
     }
-    // Integrated results: solver tolerance × 100 (math-spec §10), in the mixed norm.
+    // Integrated results: solver tolerance × 100 (docs/theory.md §verification), in the mixed norm.
     assert_eq!(failures, 0);
 }
 
@@ -240,7 +240,7 @@ fn partitioning_never_lands_on_the_mirror_branch() {
 /// projection), 11 per rejected attempt and 1 at the start ($f(t_0)$; the first step
 /// is given, so Hairer's `HINIT` does not run); the interpolant's three stages (14–16
 /// of `dop853.f`) only when the run has rows to interpolate, on the same steps
-/// (ARCHITECTURE.md, "dense output only where the run interpolates"). The first step,
+/// (docs/decisions/0023-dense-output-only-where-interpolated.md). The first step,
 /// a fifth of a period, is far too long for rtol 1e-8, so the run starts with
 /// rejections.
 #[test]
@@ -284,7 +284,7 @@ fn dop853_pays_for_dense_output_only_when_rows_interpolate() {
 
 /// On a grid coarser than the steps, DOP853 prepares its interpolant only on the
 /// steps that reach a row: three evaluations per row at most, not per step; the rows
-/// follow the exact solution (benchmark-models.md) as the steps do.
+/// follow the exact solution (docs/models.md) as the steps do.
 #[test]
 fn dop853_interpolates_only_on_steps_that_reach_a_row() {
     let model = pendulum::Model::default();

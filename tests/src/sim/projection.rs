@@ -4,7 +4,7 @@
 //! the correction has the metric it is documented with. With the model's generated solve
 //! (`LinearSolver::Auto`) the velocity change is the one of least kinetic energy,
 //! $M\Delta\dot q \in \operatorname{range} J^\mathsf{T}$ (the first block row of (E31)
-//! with the right-hand side $[0; -(J\dot q + [C_t; g])]$, math-spec §5); with the general
+//! with the right-hand side $[0; -(J\dot q + [C_t; g])]$, docs/theory.md §augmented); with the general
 //! path (`LinearSolver::Dense`) it is the orthogonal one,
 //! $\Delta\dot q \in \operatorname{range} J^\mathsf{T}$. The position correction has the
 //! same metric to first order in its size (its Newton updates take $J$ at successive

@@ -6,8 +6,8 @@
 //! **Error.** The largest error over the run (rows every 1/100 of the span), positions
 //! and velocities each relative to the largest magnitude of their kind in the reference
 //! row (at least 1): the final error alone can be small by a lucky phase. References:
-//! the pendulum's closed form (benchmark-models.md), the slider-crank's closed form
-//! (math-spec V10: the crank is driven, the rest follows from the loop), and for
+//! the pendulum's closed form (docs/models.md), the slider-crank's closed form
+//! (docs/theory.md V10: the crank is driven, the rest follows from the loop), and for
 //! `andrews` and `car_axis` a DOP853 run with projection at rtol 1e-14, atol 1e-16.
 //!
 //! **Checks.**
@@ -186,7 +186,7 @@ fn pendulum_errors_are_proportional_to_the_tolerance() {
     );
 }
 
-/// Math-spec V10 in closed form: the crank angle $\varphi_1 = \pi/6 + 10t$, the crank's
+/// docs/theory.md V10 in closed form: the crank angle $\varphi_1 = \pi/6 + 10t$, the crank's
 /// centre at $\tfrac a2 u(\varphi_1)$, $\sin\varphi_2 = -\tfrac ab\sin\varphi_1$ (the
 /// branch with $\cos\varphi_2 > 0$), the coupler's centre at
 /// $a u(\varphi_1) + \tfrac b2 u(\varphi_2)$, the slider at $a u(\varphi_1) + b u(\varphi_2)$

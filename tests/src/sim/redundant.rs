@@ -84,15 +84,17 @@ fn parallelogram_runs_through_its_flat_configurations() {
     // pass the flat configurations θ = 0 (t ≈ 0.497) and θ = −π (t ≈ 0.880), where the
     // three pin_x rows coincide and C_q has rank 4 instead of 5 while the solution set
     // stays one smooth curve. Every analysis drops the rows the shared rank rule calls
-    // dependent there and takes them back after (ARCHITECTURE.md, "Through a rank
-    // drop"). Loose and tight tolerances, both formulations, every adaptive integrator.
+    // dependent there and takes them back after
+    // (docs/decisions/0036-through-a-rank-drop.md). Loose and tight tolerances, both
+    // formulations, every adaptive integrator.
     // The tight one is 1e-11: below it an accepted state can land so near the flat
     // crossing at t ≈ 1.69006 that every attempt from it fails the dropped rows' check.
     // The driver then takes the step that reached it back and redoes it shorter
     // (`tight_runs_through_the_flat_crossings_take_failing_steps_back`), which saves
     // most such runs but not all: projection + DOP853 at 1e-12 and projection + Adams
-    // at 5e-13 still end there with the typed error, over [0, 3] s (ARCHITECTURE.md,
-    // "Through a rank drop"), a known defect of the rank-drop handling, not a bound of
+    // at 5e-13 still end there with the typed error, over [0, 3] s
+    // (docs/decisions/0036-through-a-rank-drop.md), a known defect of the rank-drop
+    // handling, not a bound of
     // this test.
     let model = parallelogram::Model::default();
     let (theta, omega) = crank_angle(std::f64::consts::FRAC_PI_3, 1.0, 2.0);
@@ -121,7 +123,7 @@ fn parallelogram_runs_through_its_flat_configurations() {
         );
         // The error is the integrator's, down to a floor of about 1e-8 set by the
         // rank drop itself: there C_q fixes φ only to the square root of the Newton
-        // tolerance (ARCHITECTURE.md).
+        // tolerance (docs/decisions/0036-through-a-rank-drop.md).
         let bound = 1e3 * rtol + 5e-8;
         assert!(
             e_theta < bound && e_omega < 3.0 * bound,

@@ -8,8 +8,9 @@
 //! steps where the run interpolates, and those neither leave the step's projection
 //! their mass matrix nor teach the chart its rate ([`pfaff::ode::OdeSystem::aside`]).
 //!
-//! The cases are those where rows used to differ (ARCHITECTURE.md, "Rows that do not
-//! depend on the grid"): projection on Euler parameters, non-holonomic rows and
+//! The cases are those where rows used to differ
+//! (docs/decisions/0023-dense-output-only-where-interpolated.md): projection on Euler
+//! parameters, non-holonomic rows and
 //! `andrews` (row 0.5 s of `free_body` with DOPRI5 at rtol 1e-3 moved by 4e-11 with 500
 //! rows, the final row of `andrews` with DOP853 by 4.4e-7), and partitioning, whose
 //! row corrections and dense stages taught the chart its rate.

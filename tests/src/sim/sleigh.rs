@@ -1,6 +1,6 @@
-//! Math-spec V11: the Chaplygin sleigh (`sleigh` model) against its closed form at
-//! t = 1, 2, 5, with every formulation; tolerance: solver tolerance × 100 (math-spec
-//! §10), plus the 5e-13 rounding of the tabulated values.
+//! docs/theory.md V11: the Chaplygin sleigh (`sleigh` model) against its closed form at
+//! t = 1, 2, 5, with every formulation; tolerance: solver tolerance × 100 (docs/theory.md
+//! §verification), plus the 5e-13 rounding of the tabulated values.
 
 use pfaff::sim::{Formulation, Method, Simulation};
 use pfaff_models::sleigh;
@@ -47,7 +47,7 @@ fn v11_closed_form_with_every_formulation() {
                 worst <= 100.0 * rtol + 5e-13,
                 "{form:?} {method:?}: {worst:e}"
             );
-            // E = ½ m v² + ½ J ω² = 1.02875 (math-spec V11).
+            // E = ½ m v² + ½ J ω² = 1.02875 (docs/theory.md V11).
             assert!((m.energy_initial.unwrap() - 1.02875).abs() < 1e-12);
             assert!(m.max_energy_drift.unwrap() < 100.0 * rtol);
             match form {

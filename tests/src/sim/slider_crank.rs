@@ -1,4 +1,4 @@
-//! The slider-crank: math-spec V10 through the simulation (assembly and the driven
+//! The slider-crank: docs/theory.md V10 through the simulation (assembly and the driven
 //! motion), a free slider-crank with a flywheel through its dead centres, and a
 //! slider-driven crank pushed past its reach.
 
@@ -10,7 +10,7 @@ use pfaff_models::slider_crank;
 
 use super::models::{flywheel_crank, slider_driven_crank};
 
-/// Math-spec V10, table at t = 0: `q` and `q̇`.
+/// docs/theory.md V10, table at t = 0: `q` and `q̇`.
 #[allow(clippy::approx_constant)] // the table's digits, not a constant
 const V10_Q: [f64; 9] = [
     0.043301270189,
@@ -35,7 +35,7 @@ const V10_QD: [f64; 9] = [
     0.0,
 ];
 
-/// Math-spec V10: $x_B = a\cos\varphi + \sqrt{b^2 - a^2\sin^2\varphi}$ and its rate for
+/// docs/theory.md V10: $x_B = a\cos\varphi + \sqrt{b^2 - a^2\sin^2\varphi}$ and its rate for
 /// $\varphi = \pi/6 + 10t$.
 fn slider(t: f64) -> (f64, f64) {
     let (a, b) = (0.1_f64, 0.3_f64);
@@ -69,7 +69,7 @@ fn v10_driven_motion_with_every_formulation() {
             .unwrap();
         let tr = &run.trajectory;
         assert_eq!(tr.len(), 101);
-        // Algebraic results at t = 0: 1e-9 relative (math-spec §10); the table has 12
+        // Algebraic results at t = 0: 1e-9 relative (docs/theory.md §verification); the table has 12
         // decimals.
         for j in 0..9 {
             assert!((tr.q(0)[j] - V10_Q[j]).abs() < 1e-11, "q[{j}] {form:?}");

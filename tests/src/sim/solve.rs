@@ -1,7 +1,7 @@
 //! The generated solve of the augmented system (`Mechanism::augmented_solve`, a sparse
 //! $LDL^\mathsf{T}$ specialized to the patterns of $M$ and $J$) against the general
 //! path of the runtime (the dense $LU$ with its rank decision, `LinearSolver::Dense`):
-//! the same $\ddot q$ and $\lambda$ of (E31), math-spec §5, on seeded random states, and
+//! the same $\ddot q$ and $\lambda$ of (E31), docs/theory.md §augmented, on seeded random states, and
 //! the general path taken whenever a pivot of the generated one is not safe.
 
 use pfaff::sim::Simulation;

@@ -1,6 +1,6 @@
 //! Contacts: `#[contact(e)] fn name() -> f64 { gap }` and the body level's
 //! `static name: Contact = PointPlane { .. }` (`PointSphere`) → the gap, its normal
-//! Jacobian and what resting contact needs (math-spec §7).
+//! Jacobian and what resting contact needs (docs/theory.md §impacts).
 //!
 //! Input: the model's contact items, translated in [`Context::Contact`] (coordinates,
 //! parameters and time; no velocities), then the body level's contacts, whose gaps the

@@ -1,4 +1,4 @@
-//! Deformable bodies in the floating frame of reference (math-spec §2–§3).
+//! Deformable bodies in the floating frame of reference (docs/theory.md §floating-frame).
 //!
 //! `static rod: Body = Deformable { origin, angle | rotation, elastic: [q1, ..], .. }`
 //! declares a body whose material point `ξ` sits at `R + A (ū_o(ξ) + N(ξ) q_f)`. Unlike a

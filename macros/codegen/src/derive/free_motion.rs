@@ -1,4 +1,4 @@
-//! Free-motion conditions (math-spec §8.6–§8.9, \[S2\] eq. 18), derived symbolically.
+//! Free-motion conditions (docs/theory.md §free-motion, \[S2\] eq. 18), derived symbolically.
 //!
 //! Input: the derived mass matrix $A$, forces $h$ (the generated `forces`, which already
 //! hold $Q + \partial T/\partial q - T_{\dot q q}\dot q - T_{\dot q t}$), the declared

@@ -1,7 +1,7 @@
 //! The linearization Jacobian, derived only for `#[mechanism(linearize)]`.
 //!
 //! Input: the derived M, Q, C_q, C_t, γ_h, G, g, γ_nh. Output: the sparse Jacobian with
-//! respect to `[q; q̇]` of the stacked residuals (math-spec §4–§6)
+//! respect to `[q; q̇]` of the stacked residuals (docs/theory.md §constraints)
 //!
 //! ```text
 //! rows 0..n            M(q) u_a + C_qᵀ u_λ + Gᵀ u_μ − Q(q, q̇, t)

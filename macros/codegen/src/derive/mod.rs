@@ -5,7 +5,7 @@
 //! acceleration right-hand sides, with their sparsity (an entry is kept only when its
 //! canonical expression is not the constant 0) and the model's structural flags.
 //!
-//! The mechanics follow math-spec §4, §5 and §8:
+//! The mechanics follow docs/theory.md §constraints, §augmented and §redundant-coordinates:
 //! - `M = ∂²T/∂q̇²`, after checking that `T` is at most quadratic in `q̇`;
 //! - `Q = Q_e + Q_v − ∂V/∂q`, `Q_v = ∂T/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t`;
 //! - `γ_h = −(d/dt)(C_q q̇ + C_t)|_{q̈=0} = −(C_q q̇)_q q̇ − 2 C_qt q̇ − C_tt`;
@@ -350,8 +350,8 @@ pub fn derive(cx: &Ctxt, model: &Model, g: &mut Graph) -> Option<Derived> {
                 }
                 // `Ċ = C_q q̇ + C_t` as the forward-mode rate of `C`, not the sum over
                 // the Jacobian's entries: the second rate then walks `C`'s DAG twice
-                // instead of differentiating every entry of `C_q` (ARCHITECTURE.md, "The
-                // body level").
+                // instead of differentiating every entry of `C_q`
+                // (docs/decisions/0009-gamma-as-second-forward-rate.md).
                 (diff::differentiate(g, h, Var::Time), diff::rate(g, h))
             }
         };

@@ -804,7 +804,7 @@ fn linearization(g: &Graph, names: &ModelNames, d: &Derived, fns: &mut TokenStre
     quote!(::core::option::Option::Some(#pattern))
 }
 
-/// The free-motion residual `w = w0 + K Q` (math-spec §8.6) as the trait methods
+/// The free-motion residual `w = w0 + K Q` (docs/theory.md §free-motion) as the trait methods
 /// `free_motion_residual` and `free_motion_conditions` (added to `fns`), and the module
 /// item `FREE_MOTION` with the printed conditions (returned). Nothing when the model has
 /// no free-motion derivation.
@@ -856,7 +856,7 @@ fn free_motion(
     });
     let formulas = crate::derive::free_motion::formulas(g, model, fm);
     let doc = doc_attr(
-        "The free-motion conditions `w = 0` of math-spec §8.6, one per constraint \
+        "The free-motion conditions `w = 0` of docs/theory.md §free-motion, one per constraint \
          (holonomic first),\nwith `x'` the velocity of `x` and `Q_x` the applied force \
          on `x`; the motion is free\n(all multipliers zero) exactly where they hold.",
     );

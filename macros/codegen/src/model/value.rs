@@ -269,7 +269,7 @@ pub fn rot_axis(g: &mut Graph, axis: usize, a: ExprId) -> Vec<ExprId> {
     }
 }
 
-/// The rotation matrix of Euler parameters (math-spec E4):
+/// The rotation matrix of Euler parameters (docs/theory.md E4):
 /// `A = (2θ0² − 1) I + 2 (ϑϑᵀ + θ0 ϑ̃)`.
 pub fn euler_rotation(g: &mut Graph, e: [ExprId; 4]) -> Vec<ExprId> {
     let two = g.constant(2.0);
@@ -307,7 +307,7 @@ pub fn euler_rotation(g: &mut Graph, e: [ExprId; 4]) -> Vec<ExprId> {
     out
 }
 
-/// `Ē` of math-spec E3 (3×4, row-major), so that `ω̄ = 2 Ē θ̇`.
+/// `Ē` of docs/theory.md E3 (3×4, row-major), so that `ω̄ = 2 Ē θ̇`.
 pub fn euler_e_bar(e: [ExprId; 4], g: &mut Graph) -> Vec<ExprId> {
     let n = |g: &mut Graph, x: ExprId| g.neg(x);
     let (t0, t1, t2, t3) = (e[0], e[1], e[2], e[3]);
@@ -315,7 +315,7 @@ pub fn euler_e_bar(e: [ExprId; 4], g: &mut Graph) -> Vec<ExprId> {
     vec![m1, t0, t3, m2, m2, m3, t0, t1, m3, t2, m1, t0]
 }
 
-/// `E` of math-spec E3 (3×4, row-major), so that `ω = 2 E θ̇`.
+/// `E` of docs/theory.md E3 (3×4, row-major), so that `ω = 2 E θ̇`.
 pub fn euler_e(e: [ExprId; 4], g: &mut Graph) -> Vec<ExprId> {
     let n = |g: &mut Graph, x: ExprId| g.neg(x);
     let (t0, t1, t2, t3) = (e[0], e[1], e[2], e[3]);

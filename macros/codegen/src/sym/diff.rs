@@ -74,7 +74,7 @@ pub fn differentiate(g: &mut Graph, e: ExprId, v: Var) -> ExprId {
 /// same sum by [`directional`] builds a partial derivative per coordinate, each a walk of
 /// the expression, and adds them: for the velocities and accelerations of a spatial
 /// mechanism, whose positions depend on many coordinates through shared rotations, that
-/// is several times larger (see ARCHITECTURE.md, "The body level").
+/// is several times larger (see docs/decisions/0006-rigid-bodies-by-kanes-method.md).
 pub fn rate(g: &mut Graph, e: ExprId) -> ExprId {
     let moving = Deps::Q.bits() | Deps::TIME.bits();
     if g.deps(e).bits() & moving == 0 {

@@ -1,5 +1,5 @@
 //! The variable-order, variable-step Adams method of Shampine & Gordon (`DE`/`STEP`/
-//! `INTRP` of `ode.f`), math-spec §9.1.
+//! `INTRP` of `ode.f`), docs/theory.md §adams.
 //!
 //! Input: an [`OdeSystem`], [`OdeOptions`], an initial state. Output: one accepted step
 //! per call, the current order, and `INTRP` dense output on the last step.
@@ -24,7 +24,7 @@
 //! The norm is a 2-norm, *not* divided by $n$, so for $n > 1$ it is stricter than the
 //! RMS norm of the Runge–Kutta methods. The estimate is that of the order-$k$ formula,
 //! while the order-$(k+1)$ corrected value is kept (local extrapolation), so the error
-//! actually committed is usually much smaller; math-spec §9.1 calls this test "error per
+//! actually committed is usually much smaller; docs/theory.md §adams calls this test "error per
 //! unit step". There is no safety factor on acceptance. At order $k$ the step size
 //! aims at $\text{erk} = a = 0.8^{k+1}\,\tfrac12\varepsilon$ (`STEP` aims at
 //! $\tfrac12\varepsilon$), i.e. the new step is $0.8\,h\,(\tfrac12\varepsilon/\text{erk})^{1/(k+1)}$:
@@ -49,8 +49,9 @@
 //! The step-size rule departs from `STEP`, whose only increase is a doubling when
 //! $\text{erk}\,2^{k+1} \le \tfrac12\varepsilon$: at order 12 that keeps $h$ while erk
 //! ranges over a factor 8192, so $h$ froze at whatever value the start phase or the last
-//! failure left and the tolerance no longer set the error (ARCHITECTURE.md, "Decision:
-//! the Adams step size follows the tolerance"). Here $h$ follows the tolerance within a
+//! failure left and the tolerance no longer set the error
+//! (docs/decisions/0022-adams-step-size-follows-the-tolerance.md). Here $h$ follows the
+//! tolerance within a
 //! factor 32 of erk, and the safety factor 0.8 on $h$ (Hairer–Nørsett–Wanner I §II.4)
 //! keeps the global error of the test problems within about 3 × rtol at no cost at
 //! equal error.

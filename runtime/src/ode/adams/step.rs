@@ -18,7 +18,7 @@ use super::super::error::OdeError;
 use super::super::system::OdeSystem;
 use super::{Adams, Coeffs};
 
-/// $\gamma^\ast_1..\gamma^\ast_{13}$ of `ode.f` (math-spec §9.1), 1-based.
+/// $\gamma^\ast_1..\gamma^\ast_{13}$ of `ode.f` (docs/theory.md §adams), 1-based.
 const GSTR: [f64; 14] = [
     0.0, 0.5, 0.0833, 0.0417, 0.0264, 0.0188, 0.0143, 0.0114, 0.00936, 0.00789, 0.00679, 0.00592,
     0.00524, 0.00468,
