@@ -87,8 +87,7 @@ pub mod parallelogram_row {
     }
 
     fn potential_energy() -> f64 {
-        mk * g * 0.5 * l * (th1.sin() + th2.sin() + th3.sin() + th4.sin() + th5.sin())
-            + mc * g * y
+        mk * g * 0.5 * l * (th1.sin() + th2.sin() + th3.sin() + th4.sin() + th5.sin()) + mc * g * y
     }
 
     /// Crank 1's tip pinned to the coupler, x.
