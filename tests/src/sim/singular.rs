@@ -12,6 +12,9 @@
 //! $T = \frac12(n m_k/3 + m_c)l^2\dot\theta^2$, $V = (\frac n2 m_k + m_c)gl\sin\theta$.
 //! It has no constraint, and is integrated by DOP853 at rtol = atol = 1e-13, checked
 //! against its own energy integral and against classical Runge–Kutta.
+//!
+//! These runs complete on the current rank-drop handling; the failures met at rtol
+//! 1e-10 and below over longer spans are recorded, not fixed, in the decision record.
 
 use std::f64::consts::FRAC_PI_3;
 
@@ -148,14 +151,15 @@ fn through_flat_crossings(model: &dyn Mechanism, cranks: usize) {
             assert!(spread < 1e-9 * theta.abs(), "spread {spread:e}");
             assert!(phi.abs() < 1e-9, "φ = {phi:e}");
             // Against the reference: the integrator's error over five crossings, with
-            // a floor for the crossings themselves (decision record 0100).
-            let bound = 2e3 * rtol + 1e-6;
+            // a floor for the crossings themselves (decision record 0100; measured
+            // at rtol 1e-9: 1.5e-11 to 9.9e-8).
+            let bound = 2e3 * rtol + 3e-7;
             assert!(e_theta < bound, "θ error {e_theta:e} > {bound:e}");
             errors.push(e_theta);
         }
         // The error falls with the tolerance, from the loosest to the tightest.
         assert!(
-            errors[2] < errors[0] && errors[1] < errors[0],
+            errors[2] < errors[1] && errors[1] < errors[0],
             "{} {}: {errors:?}",
             form.name(),
             method.name()
