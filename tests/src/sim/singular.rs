@@ -22,12 +22,12 @@ use pfaff::sim::{Formulation, Method, Run, Simulation};
 use pfaff::Mechanism;
 use pfaff_models::{parallelogram, parallelogram_row};
 
-/// The one-degree-of-freedom system equivalent to `n` cranks carrying a coupler on the
+/// The one-degree-of-freedom system equivalent to `cranks` cranks carrying a coupler on the
 /// parallelogram branch (module docs), written from its energies.
 #[pfaff::mechanism]
 pub mod equivalent_crank {
     /// Number of cranks.
-    const n: f64 = 3.0;
+    const cranks: f64 = 3.0;
     const l: f64 = 0.5;
     const mk: f64 = 1.0;
     const mc: f64 = 2.0;
@@ -36,11 +36,11 @@ pub mod equivalent_crank {
     static th: Coordinate = Coordinate {};
 
     fn kinetic_energy() -> f64 {
-        0.5 * (n * mk / 3.0 + mc) * l * l * th.dot().powi(2)
+        0.5 * (cranks * mk / 3.0 + mc) * l * l * th.dot().powi(2)
     }
 
     fn potential_energy() -> f64 {
-        (0.5 * n * mk + mc) * g * l * th.sin()
+        (0.5 * cranks * mk + mc) * g * l * th.sin()
     }
 }
 
@@ -54,8 +54,8 @@ const T_END: f64 = 2.0;
 /// $(\theta, \dot\theta)$ at `T_END` of the equivalent system of `cranks` cranks.
 fn reference(cranks: usize) -> (f64, f64) {
     let mut model = equivalent_crank::Model::default();
-    let n = model.info().parameter_index("n").unwrap();
-    model.set_parameter(n, cranks as f64);
+    let index = model.info().parameter_index("cranks").unwrap();
+    model.set_parameter(index, cranks as f64);
     let run = Simulation::new(&model)
         .formulation(Formulation::Unconstrained)
         .integrator(Method::Dop853)
