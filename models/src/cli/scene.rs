@@ -271,9 +271,9 @@ impl Scene {
             "parallelogram_row" => Self {
                 // Turning full circles from θ = π/3 at 6 rad/s: the flat configurations
                 // θ = 0, π (all links collinear, C_q one rank down) are crossed twice per
-                // turn, six times in 2 s.
+                // turn, five times in 2 s (θ(2) = 16.83).
                 t_end: 2.0,
-                span: "about three turns, six flat crossings",
+                span: "about two and a half turns, five flat crossings",
                 steady: None,
                 closed_form: None,
                 impact_times: None,
