@@ -15,6 +15,7 @@
 //! | [`seed2_example1`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
 //! | [`seed2_example2`] | `q1 q2 q3` | 1 holonomic (rheonomic) |
 //! | [`parallelogram`] | `th1 th2 th3 x y phi` | 6 holonomic (one redundant) |
+//! | [`parallelogram_row`] | `th1 … th5 x y phi` | 10 holonomic (three redundant; rank drops at the flat configurations) |
 //! | [`slider_crank_bodies`] | as `slider_crank`, from bodies and joints | 9 holonomic |
 //! | [`sleigh_bodies`] | as `sleigh`, from a body and a knife edge | 1 non-holonomic |
 //! | [`free_body`] | `x y z e0 e1 e2 e3` | 1 holonomic (Euler-parameter normalization) |
@@ -80,6 +81,8 @@ mod free_body_model;
 mod newtons_cradle_model;
 #[path = "parallelogram.rs"]
 mod parallelogram_model;
+#[path = "parallelogram_row.rs"]
+mod parallelogram_row_model;
 #[path = "pendulum_floor.rs"]
 mod pendulum_floor_model;
 #[path = "pendulum.rs"]
@@ -118,6 +121,7 @@ pub use flexible_pendulum_model::flexible_pendulum;
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
+pub use parallelogram_row_model::parallelogram_row;
 pub use pendulum_floor_model::pendulum_floor;
 pub use pendulum_model::pendulum;
 pub use rolling_disk_model::rolling_disk;
@@ -235,6 +239,12 @@ static ALL: &[Entry] = &[
         name: "parallelogram",
         summary: "parallelogram linkage with a redundant third crank (reactions of redundant constraints)",
         make: || Box::new(parallelogram::Model::default()),
+        stiff: false,
+    },
+    Entry {
+        name: "parallelogram_row",
+        summary: "row of four parallelogram windows on one coupler, turning through flat configurations (isolated rank drops)",
+        make: || Box::new(parallelogram_row::Model::default()),
         stiff: false,
     },
     Entry {

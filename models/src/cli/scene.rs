@@ -268,6 +268,16 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
+            "parallelogram_row" => Self {
+                // Turning full circles from θ = π/3 at 6 rad/s: the flat configurations
+                // θ = 0, π (all links collinear, C_q one rank down) are crossed twice per
+                // turn, five times in 2 s (θ(2) = 16.83).
+                t_end: 2.0,
+                span: "about two and a half turns, five flat crossings",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
             _ => Self::fallback(),
         }
     }

@@ -17,6 +17,7 @@ mod proportionality;
 mod redundant;
 mod robustness;
 mod rows;
+mod singular;
 mod sleigh;
 mod slider_crank;
 mod solve;

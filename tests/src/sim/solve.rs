@@ -163,7 +163,7 @@ fn redundant_constraints_take_the_general_path() {
     // configuration (models/src/bricard.rs), so a pivot of the Schur complement
     // vanishes to rounding and the general path must decide the rank; the parallelogram
     // has one redundant crank.
-    for name in ["bricard", "parallelogram"] {
+    for name in ["bricard", "parallelogram", "parallelogram_row"] {
         let model = (pfaff_models::find(name).expect("a built-in model").make)();
         for (q, qd) in run_states(model.as_ref()) {
             let auto = solve(model.as_ref(), LinearSolver::Auto, &q, &qd).expect("a solution");
@@ -276,9 +276,9 @@ fn solve_inputs(model: &dyn Mechanism, seed: u64) -> SolveInputs {
 }
 
 /// The built-in models but those with redundant constraints (Bricard's linkage, the
-/// parallelogram), whose augmented system the general path solves.
+/// parallelogram and the parallelogram row), whose augmented system the general path solves.
 fn generated_solve_models() -> impl Iterator<Item = &'static pfaff_models::Entry> {
-    let redundant = ["bricard", "parallelogram"];
+    let redundant = ["bricard", "parallelogram", "parallelogram_row"];
     pfaff_models::all()
         .iter()
         .filter(move |e| !redundant.contains(&e.name))
@@ -692,10 +692,10 @@ fn a_non_finite_input_never_gives_a_finite_generated_solution() {
         }
         assert!(tried > 0, "{}: no entry tried", info.name);
     }
-    // Every built-in model but the two redundant ones has a generated solve.
+    // Every built-in model but the three redundant ones has a generated solve.
     assert_eq!(
         models,
-        pfaff_models::all().len() - 2,
+        pfaff_models::all().len() - 3,
         "models with a generated solve"
     );
 }
@@ -713,7 +713,7 @@ fn a_non_finite_input_never_gives_a_finite_generated_solution() {
 /// 5e-8 for `bricard`.)
 #[test]
 fn the_sparse_ldlt_agrees_with_the_lu_and_leaves_dependent_rows_to_it() {
-    const REDUNDANT: [&str; 2] = ["bricard", "parallelogram"];
+    const REDUNDANT: [&str; 3] = ["bricard", "parallelogram", "parallelogram_row"];
     let mut served = Vec::new();
     let models: Vec<(&str, Box<dyn Mechanism>)> = pfaff_models::all()
         .iter()
@@ -825,7 +825,7 @@ fn the_orthogonal_solve_meets_its_defining_equations() {
             continue;
         }
         let (hol, non) = (info.holonomic_pattern, info.nonholonomic_pattern);
-        if ["bricard", "parallelogram"].contains(&entry.name) {
+        if ["bricard", "parallelogram", "parallelogram_row"].contains(&entry.name) {
             let (q, qd) = crate::states::moving_state(model, 0.05);
             let all = terms(model, 0.05, &q, &qd, false);
             let lm = info.mass_pattern.len();
@@ -960,7 +960,7 @@ fn the_orthogonal_projection_is_the_runtime_one_to_the_bit() {
             if outcome == AugmentedSolve::Unavailable && solved == AugmentedSolve::Unavailable {
                 break;
             }
-            if ["bricard", "parallelogram"].contains(&entry.name) {
+            if ["bricard", "parallelogram", "parallelogram_row"].contains(&entry.name) {
                 assert_eq!(outcome, solved, "{}", entry.name);
                 if outcome == AugmentedSolve::Declined {
                     assert_eq!(projected, qd, "{}: changed on declining", entry.name);
@@ -1180,7 +1180,7 @@ fn the_generated_normal_map_solves_the_gram_system() {
         let lm = info.mass_pattern.len();
         let hol = info.holonomic_pattern.len();
         let mut map = vec![0.0; mh * n];
-        if ["bricard", "parallelogram"].contains(&entry.name) {
+        if ["bricard", "parallelogram", "parallelogram_row"].contains(&entry.name) {
             let (q, qd) = crate::states::moving_state(model, 0.05);
             let all = terms(model, 0.05, &q, &qd, false);
             let cq = &all[lm + n..lm + n + hol];
