@@ -100,8 +100,7 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
             "method": lin.method.to_string(),
             "error_estimate": lin.error_estimate,
         });
-        println!("{value}");
-        return Ok(());
+        return super::out::line(format_args!("{value}"));
     }
     let mut w = String::new();
     let _ = writeln!(w, "{} linearized about {} (t = 0)", entry.name, about);
@@ -155,6 +154,5 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
     for note in &init.notes {
         let _ = writeln!(w, "note             {note}");
     }
-    print!("{w}");
-    Ok(())
+    super::out::print(&w)
 }

@@ -8,6 +8,7 @@ mod error;
 mod impacts;
 mod linearize;
 mod list;
+mod out;
 mod outputs;
 mod plot;
 mod precision;
@@ -54,17 +55,10 @@ fn dispatch(cli: &Cli) -> Result<(), CliError> {
         None => {
             let args = default_scene();
             simulate::command(&args)?;
-            println!("\n(`pfaff --help` lists the commands; `pfaff list` the models.)");
-            Ok(())
+            out::print("\n(`pfaff --help` lists the commands; `pfaff list` the models.)\n")
         }
-        Some(Command::List) => {
-            print!("{}", list::list());
-            Ok(())
-        }
-        Some(Command::Show { model }) => {
-            print!("{}", list::show(model)?);
-            Ok(())
-        }
+        Some(Command::List) => out::print(&list::list()),
+        Some(Command::Show { model }) => out::print(&list::show(model)?),
         Some(Command::Simulate(args)) => simulate::command(args),
         Some(Command::Linearize(args)) => linearize::command(args),
         Some(Command::WorkPrecision(args)) => precision::command(args),
@@ -128,19 +122,30 @@ pub fn main() -> ExitCode {
             }
             let message = format!("{} (see `pfaff --help`)", one_line(&e));
             if json {
-                println!("{}", error::usage(message.clone()).json());
+                if let Err(e) = out::line(format_args!("{}", error::usage(message.clone()).json()))
+                {
+                    if e.is_broken_pipe() {
+                        return ExitCode::from(e.code());
+                    }
+                }
             }
-            eprintln!("pfaff: error: {message}");
+            out::error_line(&format!("pfaff: error: {message}"));
             return ExitCode::from(2);
         }
     };
     match dispatch(&cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // Stdout closed by its reader: nothing more to say, and nowhere to say it.
+        Err(e) if e.is_broken_pipe() => ExitCode::from(e.code()),
         Err(e) => {
             if json && !e.is_reported() {
-                println!("{}", e.json());
+                if let Err(p) = out::line(format_args!("{}", e.json())) {
+                    if p.is_broken_pipe() {
+                        return ExitCode::from(p.code());
+                    }
+                }
             }
-            eprintln!("pfaff: error: {e}");
+            out::error_line(&format!("pfaff: error: {e}"));
             ExitCode::from(e.code())
         }
     }

@@ -56,7 +56,7 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
         SolverPath::Redundant => "redundant",
     };
     if args.json {
-        println!(
+        super::out::line(format_args!(
             "{}",
             json!({
                 "model": info.name,
@@ -65,16 +65,15 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
                 "solver": path,
                 "seconds_per_call": best,
             })
-        );
+        ))
     } else {
-        println!(
+        super::out::line(format_args!(
             "{}: index-1 right-hand side (M, Q, C_q, gamma and the {path} augmented solve) \
              {:.3} us per call, best of {} batches of {} calls at the initial state",
             info.name,
             best * 1e6,
             args.batches,
             args.calls
-        );
+        ))
     }
-    Ok(())
 }
