@@ -1,9 +1,29 @@
-//! The `pfaff` program: argument parsing, dispatch to one module per command, and the
-//! mapping of errors to one line on stderr and an exit code (0 success, 1 a failed
-//! computation or I/O, 2 bad input).
+//! The `pfaff` command as a library: `list`, `show`, `simulate` (summary, `--json`,
+//! `--csv`, `--plot` SVG, `--animate` HTML), `linearize`, `work-precision` and
+//! `rhs-time` for any list of models, the built-in ones (the `pfaff` program of
+//! `pfaff-models`) or a user's own:
+//!
+//! ```ignore
+//! #[pfaff::mechanism]
+//! pub mod double_pendulum { /* … */ }
+//!
+//! fn main() -> std::process::ExitCode {
+//!     pfaff_cli::main(&[pfaff_cli::model!(double_pendulum).span(5.0, "a few swings")])
+//! }
+//! ```
+//!
+//! An [`Entry`] is the name, summary and constructor of a model with what the commands
+//! know beyond its `Info` (its [`Scene`]: default span, steady motion, closed form);
+//! every part has a default. [`main`] parses the process arguments, runs the command
+//! and maps errors to one line on stderr and an exit code: 0 success, 1 a failed
+//! computation or I/O, 2 bad input, 141 stdout closed by its reader (see `out`).
+//!
+//! The modules: argument definitions in `args`, one module per command, and the shared
+//! parts (`setup`, `plot`, `scene`, `error`, `out`).
 
 mod animate;
 mod args;
+pub mod entry;
 mod error;
 mod impacts;
 mod linearize;
@@ -22,17 +42,21 @@ use std::process::ExitCode;
 use clap::error::ErrorKind;
 use clap::Parser;
 
-use args::{Cli, Command, FormulationArg, IntegratorArg, SimulateArgs, StateArgs};
+use args::{Cli, Command, FormulationArg, SimulateArgs, StateArgs};
 use error::CliError;
 
-/// The default scene: Andrews' squeezing mechanism over its reference span with the
-/// method of the seed paper (coordinate partitioning and the Adams method).
-fn default_scene() -> SimulateArgs {
+pub use entry::Entry;
+pub use scene::{ClosedForm, ImpactTimes, Scene, Steady};
+
+/// The default scene: `model` over its span with the method of the seed paper
+/// (coordinate partitioning and the Adams method, Radau5 if the model is stiff),
+/// plotted to `pfaff-MODEL.svg`.
+fn default_scene(model: &str) -> SimulateArgs {
     SimulateArgs {
-        model: "andrews".to_owned(),
+        model: model.to_owned(),
         t_end: None,
         formulation: FormulationArg::Partitioning,
-        integrator: Some(IntegratorArg::Adams),
+        integrator: None,
         rtol: 1e-6,
         atol: 1e-8,
         step: None,
@@ -42,7 +66,7 @@ fn default_scene() -> SimulateArgs {
             qd0: Vec::new(),
         },
         csv: None,
-        plot: Some("pfaff-andrews.svg".into()),
+        plot: Some(format!("pfaff-{model}.svg").into()),
         animate: None,
         samples: 500,
         json: false,
@@ -50,19 +74,20 @@ fn default_scene() -> SimulateArgs {
     }
 }
 
-fn dispatch(cli: &Cli) -> Result<(), CliError> {
+fn dispatch(models: &[Entry], default: &str, cli: &Cli) -> Result<(), CliError> {
     match &cli.command {
         None => {
-            let args = default_scene();
-            simulate::command(&args)?;
+            let args = default_scene(default);
+            simulate::command(models, &args)?;
             out::print("\n(`pfaff --help` lists the commands; `pfaff list` the models.)\n")
         }
-        Some(Command::List) => out::print(&list::list()),
-        Some(Command::Show { model }) => out::print(&list::show(model)?),
-        Some(Command::Simulate(args)) => simulate::command(args),
-        Some(Command::Linearize(args)) => linearize::command(args),
-        Some(Command::WorkPrecision(args)) => precision::command(args),
-        Some(Command::RhsTime(args)) => rhs_time::command(args),
+        Some(Command::List) => out::print(&list::list(models)),
+        Some(Command::Show { model, code: false }) => out::print(&list::show(models, model)?),
+        Some(Command::Show { model, code: true }) => out::print(&list::code(models, model)?),
+        Some(Command::Simulate(args)) => simulate::command(models, args),
+        Some(Command::Linearize(args)) => linearize::command(models, args),
+        Some(Command::WorkPrecision(args)) => precision::command(models, args),
+        Some(Command::RhsTime(args)) => rhs_time::command(models, args),
     }
 }
 
@@ -107,11 +132,25 @@ fn join_negative_values(args: impl Iterator<Item = String>) -> Vec<String> {
     out
 }
 
-/// Runs the program. With `--json` anywhere among the arguments, stdout holds exactly
-/// one JSON object whatever the exit code: the command's report, or
-/// `{"error": {"kind", "message"}}` when it failed before it had one.
-pub fn main() -> ExitCode {
-    let args = join_negative_values(std::env::args());
+/// Runs the command on the process arguments over `models`; without a command it
+/// simulates the first of them (see [`main_with_default`]).
+///
+/// With `--json` anywhere among the arguments, stdout holds exactly one JSON object
+/// whatever the exit code: the command's report, or `{"error": {"kind", "message"}}`
+/// when it failed before it had one.
+pub fn main(models: &[Entry]) -> ExitCode {
+    let default = models.first().map_or("", |e| e.name);
+    main_with_default(models, default)
+}
+
+/// As [`main`], with `default` the model simulated when no command is given.
+pub fn main_with_default(models: &[Entry], default: &str) -> ExitCode {
+    run(models, default, std::env::args())
+}
+
+/// As [`main_with_default`], on the arguments `args` (the first is the program's name).
+pub fn run(models: &[Entry], default: &str, args: impl Iterator<Item = String>) -> ExitCode {
+    let args = join_negative_values(args);
     let json = args.iter().skip(1).any(|a| a == "--json");
     let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
@@ -133,7 +172,7 @@ pub fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match dispatch(&cli) {
+    match dispatch(models, default, &cli) {
         Ok(()) => ExitCode::SUCCESS,
         // Stdout closed by its reader: nothing more to say, and nowhere to say it.
         Err(e) if e.is_broken_pipe() => ExitCode::from(e.code()),
@@ -153,7 +192,7 @@ pub fn main() -> ExitCode {
 
 /// A time for the reports: as written (`7.10352584272872`, `3`) unless it is so small or
 /// so large that its digits would fill the line (`1e-300`, not 300 zeros).
-pub(crate) fn time(t: f64) -> String {
+fn time(t: f64) -> String {
     if t == 0.0 || (1e-4..1e16).contains(&t.abs()) || !t.is_finite() {
         format!("{t}")
     } else {

@@ -9,14 +9,14 @@ use pfaff::sim::{format_table, work_precision, Formulation, Method, Reference, S
 
 use super::args::WorkPrecisionArgs;
 use super::error::{failed, usage, CliError};
-use super::scene::Scene;
 use super::{out, plot, setup};
+use crate::Entry;
 
 /// `pfaff work-precision`.
-pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
-    let entry = setup::find_model(&args.model)?;
+pub fn command(models: &[Entry], args: &WorkPrecisionArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(models, &args.model)?;
     let model = (entry.make)();
-    let scene = Scene::of(entry.name);
+    let scene = entry.scene;
     let t_end = args.t_end.unwrap_or(scene.t_end);
     if !t_end.is_finite() || t_end <= 0.0 {
         let what = if t_end <= 0.0 {

@@ -16,16 +16,17 @@ use serde_json::json;
 use super::args::RhsTimeArgs;
 use super::error::{failed, usage, CliError};
 use super::setup;
+use crate::Entry;
 
 /// `pfaff rhs-time`.
-pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
+pub fn command(models: &[Entry], args: &RhsTimeArgs) -> Result<(), CliError> {
     if args.calls == 0 || args.batches == 0 {
         return Err(usage(format!(
             "invalid --calls {} --batches {}: expected at least 1 of each",
             args.calls, args.batches
         )));
     }
-    let entry = setup::find_model(&args.model)?;
+    let entry = setup::find_model(models, &args.model)?;
     let model = setup::build(entry, &args.state.set)?;
     let init = setup::assemble(model.as_ref(), &args.state, &[], &[])?;
     let info = model.info();

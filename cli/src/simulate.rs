@@ -14,6 +14,7 @@ use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
 use super::error::{failed, usage, CliError};
 use super::scene::Scene;
 use super::{animate, impacts, out, outputs, plot, setup};
+use crate::Entry;
 
 /// A validated simulation request.
 pub struct Request<'a> {
@@ -393,13 +394,12 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
 }
 
 /// The human summary.
-pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Outcome) -> String {
+pub fn summary(model: &dyn Mechanism, req: &Request<'_>, entry: &Entry, out: &Outcome) -> String {
     let info = model.info();
     let run = &out.run;
     let (s, m) = (&run.stats, &run.monitors);
     let mut w = String::new();
-    let entry = pfaff_models::find(info.name);
-    let _ = writeln!(w, "{}: {}", info.name, entry.map_or("", |e| e.summary));
+    let _ = writeln!(w, "{}: {}", info.name, entry.description(model));
     // Redundant constraints (found by the run) remove no degree of freedom.
     let rank = info.nh() - run.redundant_constraints.len().min(info.nh());
     let dof = info.nq() - rank.min(info.nq());
@@ -426,7 +426,7 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     let span = if req.args.t_end.is_some() {
         ""
     } else {
-        scene.span
+        entry.scene.span
     };
     let _ = writeln!(
         w,
@@ -643,14 +643,13 @@ pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), Cl
 }
 
 /// `pfaff simulate`.
-pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
-    let entry = setup::find_model(&args.model)?;
+pub fn command(models: &[Entry], args: &SimulateArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(models, &args.model)?;
     let model = setup::build(entry, &args.state.set)?;
-    let scene = Scene::of(entry.name);
-    let req = request(args, &scene, entry.stiff)?;
+    let req = request(args, &entry.scene, entry.stiff)?;
     let dense = args.csv.is_some() || args.plot.is_some() || args.animate.is_some();
     let out = run(model.as_ref(), &req, dense)?;
-    report(model.as_ref(), &req, &scene, &out)
+    report(model.as_ref(), &req, entry, &out)
 }
 
 /// Prints the report of `out` and writes the requested files. With `--json` the one
@@ -663,7 +662,7 @@ pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
 pub fn report(
     model: &dyn Mechanism,
     req: &Request<'_>,
-    scene: &Scene,
+    entry: &Entry,
     out: &Outcome,
 ) -> Result<(), CliError> {
     let args = req.args;
@@ -721,7 +720,7 @@ pub fn report(
         }
         return result.map_err(CliError::reported);
     }
-    let mut text = summary(model, req, scene, out);
+    let mut text = summary(model, req, entry, out);
     for note in &notes {
         let _ = writeln!(text, "note         {note}");
     }
