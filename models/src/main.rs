@@ -1,13 +1,10 @@
-//! The `pfaff` command-line program: built-in scenes, a machine-readable summary,
-//! trajectories, plots, linearization and work-precision diagrams.
+//! The `pfaff` command-line program over the built-in models: the command itself is
+//! the library `pfaff-cli` (`cli/`), which a user's crate calls the same way with its
+//! own models.
 //!
 //! Run without arguments it simulates the default scene (Andrews' squeezing mechanism)
-//! and writes a plot; `pfaff --help` lists the commands. The modules live in
-//! `models/src/cli/`: argument definitions in `args`, one module per command, and the
-//! shared parts (`setup`, `plot`, `scene`, `error`).
-
-mod cli;
+//! and writes a plot; `pfaff --help` lists the commands.
 
 fn main() -> std::process::ExitCode {
-    cli::main()
+    pfaff_cli::main_with_default(pfaff_models::all(), "andrews")
 }

@@ -96,3 +96,48 @@ pub fn expand(args: TokenStream, input: TokenStream) -> TokenStream {
         }
     }
 }
+
+/// Expands the `#[mechanism]` module called `module` of a Rust source file, as the
+/// proc macro would: `source` is the text of the file (`include_str!`, or read from
+/// disk), the module is found among its top-level items by name, and its attribute
+/// (`#[mechanism]`, `#[pfaff::mechanism(linearize)]`, …) gives the arguments. The
+/// result is the generated module, ready for `prettyplease` (`syn::parse2::<syn::File>`
+/// then `prettyplease::unparse`); `pfaff show --code MODEL` prints it that way.
+///
+/// # Errors
+/// The file does not parse, holds no such module, or the model is rejected (the
+/// diagnostics the proc macro would report, with their spans in `source`).
+pub fn expand_source(source: &str, module: &str) -> syn::Result<TokenStream> {
+    use quote::ToTokens;
+    let file: syn::File = syn::parse_str(source)?;
+    for item in file.items {
+        let syn::Item::Mod(mut m) = item else {
+            continue;
+        };
+        if m.ident != module {
+            continue;
+        }
+        let Some(at) = m.attrs.iter().position(|a| {
+            a.path()
+                .segments
+                .last()
+                .is_some_and(|s| s.ident == "mechanism")
+        }) else {
+            return Err(syn::Error::new_spanned(
+                &m.ident,
+                format!("module `{module}` has no `#[mechanism]` attribute"),
+            ));
+        };
+        let attr = m.attrs.remove(at);
+        let args = match attr.meta {
+            syn::Meta::List(list) => list.tokens,
+            _ => TokenStream::new(),
+        };
+        let a = analyze(args, m.into_token_stream())?;
+        return Ok(emit::mechanism(&a.model, &a.derived, &a.graph));
+    }
+    Err(syn::Error::new(
+        proc_macro2::Span::call_site(),
+        format!("no module `{module}` among the top-level items of the source"),
+    ))
+}

@@ -13,7 +13,7 @@ use pfaff::sim::Run;
 use pfaff::Mechanism;
 use serde_json::{Map, Value};
 
-use super::error::{failed, CliError};
+use super::error::CliError;
 
 /// The viewer; `__TITLE__` and `__DATA__` are replaced.
 const TEMPLATE: &str = include_str!("animate.html");
@@ -65,8 +65,7 @@ pub fn write(
     path: &Path,
 ) -> Result<(), CliError> {
     let text = html(&replay(model, run, meta));
-    std::fs::write(path, text)
-        .map_err(|e| failed(format!("cannot write `{}`: {e}", path.display())))
+    super::out::write_file(path, |w| std::io::Write::write_all(w, text.as_bytes()))
 }
 
 /// The JSON embedded in an HTML file written by [`html`].

@@ -45,12 +45,19 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Writes the three-panel plot of `run` to `path`.
 pub fn trajectory(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), CliError> {
-    let e = err(path);
+    let mut svg = String::new();
+    draw_trajectory(model, run, &mut svg).map_err(err(path))?;
+    super::out::write_file(path, |w| std::io::Write::write_all(w, svg.as_bytes()))
+}
+
+/// Draws the three-panel plot of `run` as SVG into `svg`.
+fn draw_trajectory(model: &dyn Mechanism, run: &Run, svg: &mut String) -> Result<(), String> {
+    let e = |x: String| x;
     let info = model.info();
     let tr = &run.trajectory;
     let t = &tr.t;
     let n = info.nq();
-    let root = SVGBackend::new(path, (960, 1080)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (960, 1080)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
     let root = root
         .titled(
@@ -197,14 +204,26 @@ pub fn trajectory(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), C
 
 /// Writes the work-precision diagram of `rows` (error against wall time, log-log).
 pub fn work_precision(model: &str, t_end: f64, rows: &[Row], path: &Path) -> Result<(), CliError> {
-    let e = err(path);
+    let mut svg = String::new();
+    draw_work_precision(model, t_end, rows, &mut svg).map_err(err(path))?;
+    super::out::write_file(path, |w| std::io::Write::write_all(w, svg.as_bytes()))
+}
+
+/// Draws the work-precision diagram of `rows` as SVG into `svg`.
+fn draw_work_precision(
+    model: &str,
+    t_end: f64,
+    rows: &[Row],
+    svg: &mut String,
+) -> Result<(), String> {
+    let e = |x: String| x;
     let ok: Vec<&Row> = rows
         .iter()
         .filter(|r| r.failure.is_none() && r.error.is_finite())
         .collect();
     let (x0, x1) = log_range(ok.iter().map(|r| r.wall_time.as_secs_f64().max(1e-7)));
     let (y0, y1) = log_range(ok.iter().map(|r| r.error));
-    let root = SVGBackend::new(path, (960, 720)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (960, 720)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(

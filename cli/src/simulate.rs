@@ -13,7 +13,8 @@ use serde_json::{json, Map, Value};
 use super::args::{FormulationArg, IntegratorArg, SimulateArgs};
 use super::error::{failed, usage, CliError};
 use super::scene::Scene;
-use super::{animate, impacts, outputs, plot, setup};
+use super::{animate, impacts, out, outputs, plot, setup};
+use crate::Entry;
 
 /// A validated simulation request.
 pub struct Request<'a> {
@@ -393,13 +394,12 @@ pub fn json_report(model: &dyn Mechanism, req: &Request<'_>, out: &Outcome) -> V
 }
 
 /// The human summary.
-pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Outcome) -> String {
+pub fn summary(model: &dyn Mechanism, req: &Request<'_>, entry: &Entry, out: &Outcome) -> String {
     let info = model.info();
     let run = &out.run;
     let (s, m) = (&run.stats, &run.monitors);
     let mut w = String::new();
-    let entry = pfaff_models::find(info.name);
-    let _ = writeln!(w, "{}: {}", info.name, entry.map_or("", |e| e.summary));
+    let _ = writeln!(w, "{}: {}", info.name, entry.description(model));
     // Redundant constraints (found by the run) remove no degree of freedom.
     let rank = info.nh() - run.redundant_constraints.len().min(info.nh());
     let dof = info.nq() - rank.min(info.nq());
@@ -426,7 +426,7 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, scene: &Scene, out: &Ou
     let span = if req.args.t_end.is_some() {
         ""
     } else {
-        scene.span
+        entry.scene.span
     };
     let _ = writeln!(
         w,
@@ -605,107 +605,129 @@ fn no_energy(model: &pfaff::Info, run: &Run) -> &'static str {
 
 /// Writes the CSV of the trajectory: `t`, the coordinates, the velocities (`NAME'`),
 /// the model's named outputs, the multipliers (`lambda_NAME`), `position_violation`,
-/// `velocity_violation` and `energy`.
+/// `velocity_violation` and `energy` (atomically: see [`out::write_file`]).
 pub fn write_csv(model: &dyn Mechanism, run: &Run, path: &Path) -> Result<(), CliError> {
     let info = model.info();
-    let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
-    let mut w = csv::Writer::from_path(path).map_err(io)?;
-    let mut header = vec!["t".to_owned()];
-    header.extend(info.coordinates.iter().map(|c| c.name.to_owned()));
-    header.extend(info.coordinates.iter().map(|c| format!("{}'", c.name)));
-    header.extend(info.outputs.iter().map(|c| c.name.to_owned()));
-    header.extend(
-        info.holonomic
-            .iter()
-            .chain(info.nonholonomic)
-            .map(|c| format!("lambda_{}", c.name)),
-    );
-    header.extend(["position_violation", "velocity_violation", "energy"].map(String::from));
-    w.write_record(&header).map_err(io)?;
-    let tr = &run.trajectory;
-    for i in 0..tr.len() {
-        let mut rec: Vec<String> = vec![tr.t[i].to_string()];
-        rec.extend(tr.q(i).iter().map(f64::to_string));
-        rec.extend(tr.qd(i).iter().map(f64::to_string));
-        rec.extend(
-            outputs::values(model, tr.t[i], tr.q(i), tr.qd(i))
+    out::write_file(path, |file| {
+        let mut w = csv::Writer::from_writer(file);
+        let mut header = vec!["t".to_owned()];
+        header.extend(info.coordinates.iter().map(|c| c.name.to_owned()));
+        header.extend(info.coordinates.iter().map(|c| format!("{}'", c.name)));
+        header.extend(info.outputs.iter().map(|c| c.name.to_owned()));
+        header.extend(
+            info.holonomic
                 .iter()
-                .map(f64::to_string),
+                .chain(info.nonholonomic)
+                .map(|c| format!("lambda_{}", c.name)),
         );
-        rec.extend(tr.lambda(i).iter().map(f64::to_string));
-        rec.push(tr.position_violation[i].to_string());
-        rec.push(tr.velocity_violation[i].to_string());
-        rec.push(model.energy(tr.t[i], tr.q(i), tr.qd(i)).to_string());
-        w.write_record(&rec).map_err(io)?;
-    }
-    w.flush()
-        .map_err(|e| failed(format!("cannot write `{}`: {e}", path.display())))
+        header.extend(["position_violation", "velocity_violation", "energy"].map(String::from));
+        w.write_record(&header)?;
+        let tr = &run.trajectory;
+        for i in 0..tr.len() {
+            let mut rec: Vec<String> = vec![tr.t[i].to_string()];
+            rec.extend(tr.q(i).iter().map(f64::to_string));
+            rec.extend(tr.qd(i).iter().map(f64::to_string));
+            rec.extend(
+                outputs::values(model, tr.t[i], tr.q(i), tr.qd(i))
+                    .iter()
+                    .map(f64::to_string),
+            );
+            rec.extend(tr.lambda(i).iter().map(f64::to_string));
+            rec.push(tr.position_violation[i].to_string());
+            rec.push(tr.velocity_violation[i].to_string());
+            rec.push(model.energy(tr.t[i], tr.q(i), tr.qd(i)).to_string());
+            w.write_record(&rec)?;
+        }
+        w.flush()
+    })
 }
 
 /// `pfaff simulate`.
-pub fn command(args: &SimulateArgs) -> Result<(), CliError> {
-    let entry = setup::find_model(&args.model)?;
+pub fn command(models: &[Entry], args: &SimulateArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(models, &args.model)?;
     let model = setup::build(entry, &args.state.set)?;
-    let scene = Scene::of(entry.name);
-    let req = request(args, &scene, entry.stiff)?;
+    let req = request(args, &entry.scene, entry.stiff)?;
     let dense = args.csv.is_some() || args.plot.is_some() || args.animate.is_some();
     let out = run(model.as_ref(), &req, dense)?;
-    report(model.as_ref(), &req, &scene, &out)
+    report(model.as_ref(), &req, entry, &out)
 }
 
 /// Prints the report of `out` and writes the requested files. With `--json` the one
 /// object on stdout carries the first failure (of the run, else of a file).
+///
+/// Each file is written on its own (atomically, see [`out::write_file`]): a failure to
+/// write one is reported on stderr and does not keep the others from being written. A
+/// run that stopped before its first state writes no file, so that files of an earlier
+/// run are left as they were.
 pub fn report(
     model: &dyn Mechanism,
     req: &Request<'_>,
-    scene: &Scene,
+    entry: &Entry,
     out: &Outcome,
 ) -> Result<(), CliError> {
-    let mut files = Ok(());
-    if let Some(path) = &req.args.csv {
-        files = write_csv(model, &out.run, path);
+    let args = req.args;
+    let requested = [
+        ("trajectory", &args.csv),
+        ("plot", &args.plot),
+        ("animation", &args.animate),
+    ];
+    let mut written: Vec<(&str, &Path)> = Vec::new();
+    let mut failures = Vec::new();
+    let mut notes = out.notes.clone();
+    if out.run.trajectory.is_empty() {
+        if requested.iter().any(|(_, p)| p.is_some()) {
+            notes.push(
+                "no file written: the run computed no state (existing files are left as they were)"
+                    .to_owned(),
+            );
+        }
+    } else {
+        for (what, path) in requested {
+            let Some(path) = path else { continue };
+            let result = match what {
+                "trajectory" => write_csv(model, &out.run, path),
+                "plot" => plot::trajectory(model, &out.run, path),
+                _ => animate::write(model, &out.run, animation_meta(req, out), path),
+            };
+            match result {
+                Ok(()) => written.push((what, path)),
+                Err(e) => failures.push(e),
+            }
+        }
     }
-    if let (Some(path), Ok(())) = (&req.args.plot, &files) {
-        files = plot::trajectory(model, &out.run, path);
-    }
-    if let (Some(path), Ok(())) = (&req.args.animate, &files) {
-        files = animate::write(model, &out.run, animation_meta(req, out), path);
-    }
-    let files = files.map_err(|e| e.kind("io"));
+    let files = out::failures(failures);
     let result = match (&out.error, files) {
-        (Some(kind), _) => Err(failed(format!(
-            "simulation of `{}` failed: {kind}",
-            model.info().name
-        ))
-        .kind(kind_name(kind))),
+        (Some(kind), files) => {
+            if let Err(e) = files {
+                out::error_line(&format!("pfaff: error: {e}"));
+            }
+            Err(failed(format!(
+                "simulation of `{}` failed: {kind}",
+                model.info().name
+            ))
+            .kind(kind_name(kind)))
+        }
         (None, files) => files,
     };
-    if req.args.json {
+    if args.json {
         let mut obj = json_report(model, req, out);
         if let (Err(e), None) = (&result, &out.error) {
             obj["error"] = e.entry();
         }
-        println!("{obj}");
-        for note in &out.notes {
-            eprintln!("pfaff: note: {note}");
+        out::line(format_args!("{obj}"))?;
+        for note in &notes {
+            out::error_line(&format!("pfaff: note: {note}"));
         }
         return result.map_err(CliError::reported);
     }
-    print!("{}", summary(model, req, scene, out));
-    for note in &out.notes {
-        println!("note         {note}");
+    let mut text = summary(model, req, entry, out);
+    for note in &notes {
+        let _ = writeln!(text, "note         {note}");
     }
-    if result.is_ok() {
-        if let Some(path) = &req.args.csv {
-            println!("trajectory   {}", path.display());
-        }
-        if let Some(path) = &req.args.plot {
-            println!("plot         {}", path.display());
-        }
-        if let Some(path) = &req.args.animate {
-            println!("animation    {}", path.display());
-        }
+    for (what, path) in written {
+        let _ = writeln!(text, "{what:<12} {}", path.display());
     }
+    out::print(&text)?;
     result
 }
 

@@ -16,16 +16,17 @@ use serde_json::json;
 use super::args::RhsTimeArgs;
 use super::error::{failed, usage, CliError};
 use super::setup;
+use crate::Entry;
 
 /// `pfaff rhs-time`.
-pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
+pub fn command(models: &[Entry], args: &RhsTimeArgs) -> Result<(), CliError> {
     if args.calls == 0 || args.batches == 0 {
         return Err(usage(format!(
             "invalid --calls {} --batches {}: expected at least 1 of each",
             args.calls, args.batches
         )));
     }
-    let entry = setup::find_model(&args.model)?;
+    let entry = setup::find_model(models, &args.model)?;
     let model = setup::build(entry, &args.state.set)?;
     let init = setup::assemble(model.as_ref(), &args.state, &[], &[])?;
     let info = model.info();
@@ -56,7 +57,7 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
         SolverPath::Redundant => "redundant",
     };
     if args.json {
-        println!(
+        super::out::line(format_args!(
             "{}",
             json!({
                 "model": info.name,
@@ -65,16 +66,15 @@ pub fn command(args: &RhsTimeArgs) -> Result<(), CliError> {
                 "solver": path,
                 "seconds_per_call": best,
             })
-        );
+        ))
     } else {
-        println!(
+        super::out::line(format_args!(
             "{}: index-1 right-hand side (M, Q, C_q, gamma and the {path} augmented solve) \
              {:.3} us per call, best of {} batches of {} calls at the initial state",
             info.name,
             best * 1e6,
             args.batches,
             args.calls
-        );
+        ))
     }
-    Ok(())
 }

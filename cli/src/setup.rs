@@ -9,19 +9,19 @@
 //! declared by the model (`qd0`) are held where the constraints allow it; one that the
 //! constraints determine from the others gets a note with the value used.
 
+use crate::Entry;
 use pfaff::{
     AssemblyError, Kinematics, KinematicsParams, Mechanism, PartitionError, PartitionParams,
 };
 use pfaff::{Prescription, Workspace};
-use pfaff_models::Entry;
 
 use super::args::{Assignment, StateArgs};
 use super::error::{failed, suggestion, usage, CliError};
 
-/// The built-in model called `name`.
-pub fn find_model(name: &str) -> Result<&'static Entry, CliError> {
-    pfaff_models::find(name).ok_or_else(|| {
-        let hint = suggestion(name, pfaff_models::all().iter().map(|e| e.name));
+/// The model of `models` called `name`.
+pub fn find_model<'a>(models: &'a [Entry], name: &str) -> Result<&'a Entry, CliError> {
+    models.iter().find(|e| e.name == name).ok_or_else(|| {
+        let hint = suggestion(name, models.iter().map(|e| e.name));
         usage(format!(
             "unknown model `{name}`{hint} (`pfaff list` shows the models)"
         ))

@@ -8,14 +8,14 @@ use serde_json::json;
 
 use super::args::LinearizeArgs;
 use super::error::{failed, usage, CliError};
-use super::scene::Scene;
 use super::setup;
+use crate::Entry;
 
 /// `pfaff linearize`.
-pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
-    let entry = setup::find_model(&args.model)?;
+pub fn command(models: &[Entry], args: &LinearizeArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(models, &args.model)?;
     let model = setup::build(entry, &args.state.set)?;
-    let scene = Scene::of(entry.name);
+    let scene = entry.scene;
     let mut guesses: Vec<(&str, f64)> = Vec::new();
     let mut velocities: Vec<(&str, f64)> = Vec::new();
     let mut ignorable: &[&str] = &[];
@@ -40,9 +40,15 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
         }
     }
     if args.speed.is_some() && scene.steady.and_then(|s| s.speed).is_none() {
+        let with: Vec<&str> = models
+            .iter()
+            .filter(|e| e.scene.steady.and_then(|s| s.speed).is_some())
+            .map(|e| e.name)
+            .collect();
         return Err(usage(format!(
-            "model `{}` defines no steady forward motion, so --speed does not apply (it does for: sleigh, rolling_disk, bicycle)",
-            entry.name
+            "model `{}` defines no steady forward motion, so --speed does not apply (it does for: {})",
+            entry.name,
+            if with.is_empty() { "none of the models".to_owned() } else { with.join(", ") }
         )));
     }
     // The steady motion's values are guesses; --q0/--qd0 are held (and win), and then
@@ -100,8 +106,7 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
             "method": lin.method.to_string(),
             "error_estimate": lin.error_estimate,
         });
-        println!("{value}");
-        return Ok(());
+        return super::out::line(format_args!("{value}"));
     }
     let mut w = String::new();
     let _ = writeln!(w, "{} linearized about {} (t = 0)", entry.name, about);
@@ -155,6 +160,5 @@ pub fn command(args: &LinearizeArgs) -> Result<(), CliError> {
     for note in &init.notes {
         let _ = writeln!(w, "note             {note}");
     }
-    print!("{w}");
-    Ok(())
+    super::out::print(&w)
 }

@@ -2,15 +2,15 @@
 
 use std::fmt::Write as _;
 
-use super::error::CliError;
-use super::scene::Scene;
+use super::error::{failed, usage, CliError};
 use super::setup;
+use crate::Entry;
 
 /// The table of `pfaff list`.
-pub fn list() -> String {
+pub fn list(models: &[Entry]) -> String {
     let mut w = String::new();
     // The name column as wide as the longest name.
-    let width = pfaff_models::all()
+    let width = models
         .iter()
         .map(|e| e.name.len())
         .max()
@@ -21,8 +21,9 @@ pub fn list() -> String {
         "{:<width$} {:>3} {:>4} {:>5} {:>8} {:>8} {:>6} {:>6}  description",
         "model", "nq", "hol", "nhol", "contacts", "t_end", "bodies", "joints"
     );
-    for e in pfaff_models::all() {
+    for e in models {
         let model = (e.make)();
+        let summary = e.description(model.as_ref());
         let info = model.info();
         let _ = writeln!(
             w,
@@ -32,7 +33,7 @@ pub fn list() -> String {
             info.nh(),
             info.nnh(),
             info.ncontacts(),
-            Scene::of(e.name)
+            e.scene
                 .t_end
                 .to_string()
                 .chars()
@@ -41,9 +42,9 @@ pub fn list() -> String {
             info.bodies.len(),
             info.joints.len(),
             if e.stiff {
-                format!("{} [stiff]", e.summary)
+                format!("{summary} [stiff]")
             } else {
-                e.summary.to_owned()
+                summary
             }
         );
     }
@@ -59,12 +60,12 @@ fn first_line(doc: &str) -> &str {
 }
 
 /// The description of `pfaff show MODEL`.
-pub fn show(name: &str) -> Result<String, CliError> {
-    let entry = setup::find_model(name)?;
+pub fn show(models: &[Entry], name: &str) -> Result<String, CliError> {
+    let entry = setup::find_model(models, name)?;
     let model = (entry.make)();
     let info = model.info();
     let mut w = String::new();
-    let _ = writeln!(w, "{}: {}", info.name, entry.summary);
+    let _ = writeln!(w, "{}: {}", info.name, entry.description(model.as_ref()));
     let (n, mut q0, mut qd0) = (info.nq(), Vec::new(), Vec::new());
     q0.resize(n, 0.0);
     qd0.resize(n, 0.0);
@@ -114,7 +115,7 @@ pub fn show(name: &str) -> Result<String, CliError> {
             first_line(c.doc)
         );
     }
-    let scene = Scene::of(info.name);
+    let scene = entry.scene;
     let _ = writeln!(w, "default span: 0 to {} s ({})", scene.t_end, scene.span);
     if entry.stiff {
         let _ = writeln!(
@@ -193,4 +194,26 @@ fn body_level(w: &mut String, model: &dyn pfaff::Mechanism, q0: &[f64]) {
     for o in info.outputs {
         let _ = writeln!(w, "  {:<10} {}", o.name, first_line(o.doc));
     }
+}
+
+/// The generated code of `pfaff show --code MODEL`: the model's source (carried by its
+/// entry) expanded by [`pfaff_codegen::expand_source`] and formatted by prettyplease.
+pub fn code(models: &[Entry], name: &str) -> Result<String, CliError> {
+    let entry = setup::find_model(models, name)?;
+    let source = entry.source.ok_or_else(|| {
+        usage(format!(
+            "model `{name}` carries no source: its entry needs `.source(include_str!(\"FILE.rs\"))` for --code"
+        ))
+    })?;
+    let located = |e: syn::Error| {
+        let at = e.span().start();
+        failed(format!(
+            "cannot expand model `{name}` (line {}, column {} of its source): {e}",
+            at.line,
+            at.column + 1
+        ))
+    };
+    let tokens = pfaff_codegen::expand_source(source, name).map_err(located)?;
+    let file: syn::File = syn::parse2(tokens).map_err(located)?;
+    Ok(prettyplease::unparse(&file))
 }

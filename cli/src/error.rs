@@ -41,6 +41,11 @@ impl CliError {
         self.reported
     }
 
+    /// Whether stdout was closed by its reader: the program ends quietly.
+    pub fn is_broken_pipe(&self) -> bool {
+        self.kind == "broken_pipe"
+    }
+
     /// The `error` entry of a JSON report: `kind` and `message`.
     pub fn entry(&self) -> Value {
         json!({"kind": self.kind, "message": self.message})
@@ -76,6 +81,17 @@ pub fn failed(message: impl Into<String>) -> CliError {
         kind: "failed",
         message: message.into(),
         reported: false,
+    }
+}
+
+/// Stdout closed by its reader (`pfaff list | head -1`): the program ends without a
+/// message, with the status of a process killed by SIGPIPE (see `out`).
+pub fn broken_pipe() -> CliError {
+    CliError {
+        code: super::out::BROKEN_PIPE_STATUS,
+        kind: "broken_pipe",
+        message: "stdout was closed".to_owned(),
+        reported: true,
     }
 }
 

@@ -9,14 +9,14 @@ use pfaff::sim::{format_table, work_precision, Formulation, Method, Reference, S
 
 use super::args::WorkPrecisionArgs;
 use super::error::{failed, usage, CliError};
-use super::scene::Scene;
-use super::{plot, setup};
+use super::{out, plot, setup};
+use crate::Entry;
 
 /// `pfaff work-precision`.
-pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
-    let entry = setup::find_model(&args.model)?;
+pub fn command(models: &[Entry], args: &WorkPrecisionArgs) -> Result<(), CliError> {
+    let entry = setup::find_model(models, &args.model)?;
     let model = (entry.make)();
-    let scene = Scene::of(entry.name);
+    let scene = entry.scene;
     let t_end = args.t_end.unwrap_or(scene.t_end);
     if !t_end.is_finite() || t_end <= 0.0 {
         let what = if t_end <= 0.0 {
@@ -81,26 +81,45 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
         sweep.rtols = (3..=9).map(|k| 10f64.powi(-k)).collect();
     }
     let rows = work_precision(model.as_ref(), &sweep, &reference);
-    println!(
+    out::line(format_args!(
         "work-precision of {} over [0, {}] s; error = largest |final q, q' - reference| over the largest |q|, |q'| of the reference (at least 1), reference: {source}",
         entry.name,
         super::time(t_end)
-    );
+    ))?;
     if entry.stiff && !args.all_methods {
-        println!(
+        out::line(format_args!(
             "stiff model: radau5 only (the explicit methods are held to their stability limit; --all-methods sweeps them too)"
-        );
+        ))?;
     }
     if !reference.impacts.is_empty() {
-        println!(
+        out::line(format_args!(
             "t_impact = largest |impact time - closed form| over the {} impacts of the span [s]",
             reference.impacts.len()
-        );
+        ))?;
     }
-    print!("{}", format_table(&rows));
+    out::print(&format_table(&rows))?;
+    // Each file is written on its own: a failure to write one is reported and does not
+    // keep the other from being written.
+    let mut failures = Vec::new();
     if let Some(path) = &args.csv {
-        let io = |e: csv::Error| failed(format!("cannot write `{}`: {e}", path.display()));
-        let mut w = csv::Writer::from_path(path).map_err(io)?;
+        match write_csv(&rows, path) {
+            Ok(()) => out::line(format_args!("table  {}", path.display()))?,
+            Err(e) => failures.push(e),
+        }
+    }
+    if let Some(path) = &args.plot {
+        match plot::work_precision(entry.name, t_end, &rows, path) {
+            Ok(()) => out::line(format_args!("plot   {}", path.display()))?,
+            Err(e) => failures.push(e),
+        }
+    }
+    out::failures(failures)
+}
+
+/// Writes the table of `rows` as CSV to `path` (atomically).
+fn write_csv(rows: &[pfaff::sim::Row], path: &std::path::Path) -> Result<(), CliError> {
+    out::write_file(path, |file| {
+        let mut w = csv::Writer::from_writer(file);
         w.write_record([
             "formulation",
             "method",
@@ -113,9 +132,8 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
             "repartitions",
             "wall_seconds",
             "failure",
-        ])
-        .map_err(io)?;
-        for r in &rows {
+        ])?;
+        for r in rows {
             w.write_record([
                 r.formulation.name().to_owned(),
                 r.method.name().to_owned(),
@@ -128,16 +146,8 @@ pub fn command(args: &WorkPrecisionArgs) -> Result<(), CliError> {
                 r.repartitions.to_string(),
                 r.wall_time.as_secs_f64().to_string(),
                 r.failure.clone().unwrap_or_default(),
-            ])
-            .map_err(io)?;
+            ])?;
         }
         w.flush()
-            .map_err(|e| failed(format!("cannot write `{}`: {e}", path.display())))?;
-        println!("table  {}", path.display());
-    }
-    if let Some(path) = &args.plot {
-        plot::work_precision(entry.name, t_end, &rows, path)?;
-        println!("plot   {}", path.display());
-    }
-    Ok(())
+    })
 }

@@ -4,11 +4,12 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-/// Simulate constrained multibody systems: the built-in mechanisms of pfaff.
+/// Simulate constrained multibody systems written with pfaff.
 ///
-/// Without a command, simulates Andrews' squeezing mechanism over its reference span
-/// (0.03 s) with coordinate partitioning and the Adams method, prints a summary and
-/// writes the plot `pfaff-andrews.svg` in the current directory.
+/// Without a command, simulates the default model over its span (for the built-in
+/// models Andrews' squeezing mechanism over its reference span of 0.03 s) with
+/// coordinate partitioning and the Adams method, prints a summary and writes the plot
+/// `pfaff-MODEL.svg` in the current directory.
 #[derive(Debug, Parser)]
 #[command(name = "pfaff", version, about, long_about)]
 pub struct Cli {
@@ -26,6 +27,10 @@ pub enum Command {
     Show {
         /// The model (see `pfaff list`).
         model: String,
+        /// Print the code `#[pfaff::mechanism]` generates for the model instead
+        /// (formatted; for models whose entry carries their source).
+        #[arg(long)]
+        code: bool,
     },
     /// Simulate a model and report, optionally writing a trajectory and a plot.
     Simulate(SimulateArgs),
