@@ -29,6 +29,8 @@
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
 //! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
 //! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
+//! | [`flexible_sleigh`] | `x y phi p1 p2 p3` | 1 non-holonomic at a material point of an elastic tail (beam elements) |
+//! | [`flexible_sleigh_wall`] | as `flexible_sleigh` | 1 non-holonomic, 1 contact |
 //! | [`flexible_pendulum`] | `e0 e1 e2 e3 p1 p2 p3 p4` | 1 holonomic (Euler-parameter normalization); a bar of spatial beam elements |
 //!
 //! [`chain100`] (`i = 1 … 100`: 700 coordinates, 400 holonomic) is built for scaling
@@ -74,6 +76,8 @@ mod chain_models {
 mod flexible_crank_model;
 #[path = "flexible_pendulum.rs"]
 mod flexible_pendulum_model;
+#[path = "flexible_sleigh.rs"]
+mod flexible_sleigh_model;
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -115,6 +119,7 @@ pub use chain_models::{chain10, chain100};
 pub use falling_rod_model::falling_rod;
 pub use flexible_crank_model::{flexible_crank, flexible_crank_shapes};
 pub use flexible_pendulum_model::flexible_pendulum;
+pub use flexible_sleigh_model::{flexible_sleigh, flexible_sleigh_wall};
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
@@ -302,6 +307,18 @@ static ALL: &[Entry] = &[
         summary: "spin-up of a cantilever beam, geometric stiffening switched by `stiffening` (Kane, Ryan & Banerjee 1987)",
         make: || Box::new(spinup_beam::Model::default()),
         stiff: true,
+    },
+    Entry {
+        name: "flexible_sleigh",
+        summary: "Chaplygin sleigh whose blade is at the free end of an elastic tail of beam elements",
+        make: || Box::new(flexible_sleigh::Model::default()),
+        stiff: false,
+    },
+    Entry {
+        name: "flexible_sleigh_wall",
+        summary: "the sleigh of `flexible_sleigh` striking a wall with its front tip",
+        make: || Box::new(flexible_sleigh_wall::Model::default()),
+        stiff: false,
     },
     Entry {
         name: "chain10",
