@@ -15,6 +15,7 @@ mod rhs_time;
 mod scene;
 mod setup;
 mod simulate;
+mod split;
 
 use std::process::ExitCode;
 

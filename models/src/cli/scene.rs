@@ -268,6 +268,20 @@ impl Scene {
                 closed_form: None,
                 impact_times: None,
             },
+            "flexible_sleigh" => Self {
+                t_end: 2.0,
+                span: "about 22 periods of the tail's first mode",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
+            "flexible_sleigh_wall" => Self {
+                t_end: 1.0,
+                span: "1 s from the impact",
+                steady: None,
+                closed_form: None,
+                impact_times: None,
+            },
             _ => Self::fallback(),
         }
     }
