@@ -22,13 +22,13 @@ fn elastic(model: &dyn Mechanism, t: f64, q: &[f64]) -> Vec<usize> {
     model.point_positions(t, q, &mut p0);
     let mut out = Vec::new();
     let mut x = q.to_vec();
-    for i in 0..q.len() {
-        let h = 1e-3 * (1.0 + q[i].abs());
-        x[i] = q[i] + h;
+    for (i, &qi) in q.iter().enumerate() {
+        let h = 1e-3 * (1.0 + qi.abs());
+        x[i] = qi + h;
         let (mut f1, mut p1) = (vec![0.0; nf], vec![0.0; np]);
         model.frame_poses(t, &x, &mut f1);
         model.point_positions(t, &x, &mut p1);
-        x[i] = q[i];
+        x[i] = qi;
         let moved = |a: &[f64], b: &[f64]| a.iter().zip(b).any(|(u, v)| u != v);
         if !moved(&f0, &f1) && moved(&p0, &p1) {
             out.push(i);
