@@ -36,6 +36,7 @@ mod rhs_time;
 mod scene;
 mod setup;
 mod simulate;
+mod split;
 
 use std::process::ExitCode;
 

@@ -103,6 +103,8 @@ pub fn show(models: &[Entry], name: &str) -> Result<String, CliError> {
     for c in info.nonholonomic {
         let _ = writeln!(w, "  {:<10} {}", c.name, first_line(c.doc));
     }
+    let _ = writeln!(w, "\nat the default initial guess:");
+    w.push_str(&super::split::describe(model.as_ref(), 0.0, &q0, "  "));
     body_level(&mut w, model.as_ref(), &q0);
     let _ = writeln!(w, "\ncontacts ({}):", info.ncontacts());
     for c in info.contacts {

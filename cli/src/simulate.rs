@@ -412,6 +412,14 @@ pub fn summary(model: &dyn Mechanism, req: &Request<'_>, entry: &Entry, out: &Ou
         info.nnh(),
         if dof == 1 { "" } else { "s" }
     );
+    if !run.trajectory.is_empty() {
+        w.push_str(&super::split::describe(
+            model,
+            run.trajectory.t[0],
+            run.trajectory.q(0),
+            "  ",
+        ));
+    }
     let tol = match req.method {
         // RK4 halves an attempt whose evaluation failed recoverably (a Newton failure of
         // the chart); the next step has the nominal size again.

@@ -30,6 +30,8 @@
 //! | [`flexible_crank`] | `phi1 phi2 x3 q1 q2 q3 q4` | 3 holonomic (one rheonomic driver); an elastic rod |
 //! | [`spinup_beam`] | `w1 w2 w3 w4 u1 u2 u3` | none (prescribed hub angle); geometric stiffening switchable |
 //! | [`flexible_crank_shapes`] | as `flexible_crank`, the rod integrated from its shape functions | 3 holonomic |
+//! | [`flexible_sleigh`] | `x y phi p1 p2 p3` | 1 non-holonomic at a material point of an elastic tail (beam elements) |
+//! | [`flexible_sleigh_wall`] | as `flexible_sleigh` | 1 non-holonomic, 1 contact |
 //! | [`flexible_pendulum`] | `e0 e1 e2 e3 p1 p2 p3 p4` | 1 holonomic (Euler-parameter normalization); a bar of spatial beam elements |
 //!
 //! [`chain100`] (`i = 1 … 100`: 700 coordinates, 400 holonomic) is built for scaling
@@ -75,6 +77,8 @@ mod chain_models {
 mod flexible_crank_model;
 #[path = "flexible_pendulum.rs"]
 mod flexible_pendulum_model;
+#[path = "flexible_sleigh.rs"]
+mod flexible_sleigh_model;
 #[path = "free_body.rs"]
 mod free_body_model;
 #[path = "newtons_cradle.rs"]
@@ -118,6 +122,7 @@ pub use chain_models::{chain10, chain100};
 pub use falling_rod_model::falling_rod;
 pub use flexible_crank_model::{flexible_crank, flexible_crank_shapes};
 pub use flexible_pendulum_model::flexible_pendulum;
+pub use flexible_sleigh_model::{flexible_sleigh, flexible_sleigh_wall};
 pub use free_body_model::free_body;
 pub use newtons_cradle_model::newtons_cradle;
 pub use parallelogram_model::parallelogram;
@@ -401,6 +406,20 @@ static ALL: &[Entry] = &[
         .stiff()
         .span(20.0, "the benchmark's span: spin-up over 15 s, then 5 s at constant rate")
         .source(include_str!("spinup_beam.rs")),
+    Entry::new(
+        "flexible_sleigh",
+        "Chaplygin sleigh whose blade is at the free end of an elastic tail of beam elements",
+        || Box::new(flexible_sleigh::Model::default()),
+    )
+        .span(2.0, "about 22 periods of the tail's first mode")
+        .source(include_str!("flexible_sleigh.rs")),
+    Entry::new(
+        "flexible_sleigh_wall",
+        "the sleigh of `flexible_sleigh` striking a wall with its front tip",
+        || Box::new(flexible_sleigh_wall::Model::default()),
+    )
+        .span(1.0, "1 s from the impact")
+        .source(include_str!("flexible_sleigh.rs")),
     Entry::new(
         "chain10",
         "spatial chain of 10 rods on ball joints, Euler parameters (scaling, n = 70)",

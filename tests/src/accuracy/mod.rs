@@ -17,6 +17,7 @@ pub(crate) mod util;
 mod andrews;
 mod car_axis;
 pub(crate) mod coverage;
+pub(crate) mod flexible_sleigh;
 mod pendulum;
 mod seed2;
 mod sleigh;

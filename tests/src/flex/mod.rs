@@ -5,6 +5,7 @@
 
 mod crank;
 mod models;
+mod nonholonomic;
 mod pendulum;
 mod shapes;
 mod spinup;

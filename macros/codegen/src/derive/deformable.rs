@@ -26,14 +26,15 @@
 //! `ε = u' + ½ w'²`, i.e. the extra energy `s · ½ EA ∫ (u' w'² + ¼ w'⁴) dx`.
 //!
 //! A body built from beam elements (`data: slot`, a `Beam`/`SpatialBeam` slot) reads
-//! its invariants, `K_ff`, its nodes (`body.node(k)`: `x_k + T_k q_f`) and, with
-//! `stiffening: s`, the centrifugal geometric stiffness `K_Ω` from the slot: the force
-//! `−s (ω̄_y² + ω̄_z²) K_Ω q_f` (planar `−s θ̇² K_Ω q_f`). The nonlinear axial strain is
-//! not used there: the modes of a free-ended beam have no axial strain at the tip, so
-//! they cannot take up the foreshortening `−½ w'²` of the bent beam and its `¼ EA w'⁴`
-//! locks the bending (the spin-up beam with 16 elements, 4 bending and 3 axial modes,
-//! reached 0.28 m of tip deflection against 0.53 m from the shape functions' cubic
-//! axial ansatz).
+//! its invariants, `K_ff`, its nodes (`body.node(k)`: `x_k + T_k q_f`; the small
+//! elastic rotation of node k's section, `body.node_rotation(k)`, from the rotation
+//! rows of `T_k`) and, with `stiffening: s`, the centrifugal geometric stiffness `K_Ω`
+//! from the slot: the force `−s (ω̄_y² + ω̄_z²) K_Ω q_f` (planar `−s θ̇² K_Ω q_f`).
+//! The nonlinear axial strain is not used there: the modes of a free-ended beam have no
+//! axial strain at the tip, so they cannot take up the foreshortening `−½ w'²` of the
+//! bent beam and its `¼ EA w'⁴` locks the bending (the spin-up beam with 16 elements, 4
+//! bending and 3 axial modes, reached 0.28 m of tip deflection against 0.53 m from the
+//! shape functions' cubic axial ansatz).
 
 use proc_macro2::Span;
 

@@ -153,6 +153,23 @@ impl Nodes {
     }
 }
 
+impl Nodes {
+    /// Node `k`'s small elastic rotation of its section in the body's frame: planar the
+    /// angle `θ_k` (the slope `v'`), spatial `(θx, θy, θz)`; the nodal rotation
+    /// coordinates of `T_k q_f`.
+    pub fn rotation(&self, g: &mut Graph, dim: usize, k: usize) -> Vec<ExprId> {
+        let n = self.qf.len();
+        let q: Vec<ExprId> = self.qf.iter().map(|&i| g.var(Var::Q(i))).collect();
+        let first = if dim == 2 { 2 } else { 3 };
+        (first..self.dofs_per_node)
+            .map(|c| {
+                let row = &self.basis[(k * self.dofs_per_node + c) * n..][..n];
+                dot(g, row, &q)
+            })
+            .collect()
+    }
+}
+
 impl Material {
     /// `ū_o(ξ) + N(ξ) q_f` at `xi`, in the body's frame (the current translation context).
     pub fn at(
@@ -457,6 +474,7 @@ const FRAME_METHODS: &[&str] = &[
     "angle",
     "material",
     "node",
+    "node_rotation",
 ];
 const MATRIX_FUNCTIONS: &[&str] = &[
     "rot2",
@@ -964,7 +982,7 @@ impl Translator<'_> {
         let fv = self.frame_value(f, dim);
         let want = usize::from(matches!(
             name,
-            "point" | "axis" | "velocity" | "material" | "node"
+            "point" | "axis" | "velocity" | "material" | "node" | "node_rotation"
         ));
         if m.args.len() != want {
             self.cx.error_spanned_by(
@@ -1038,7 +1056,7 @@ impl Translator<'_> {
                 self.expanding_materials.pop();
                 Value::Vector(at?)
             }
-            "node" => {
+            "node" | "node_rotation" => {
                 let nodes = f.and_then(|k| {
                     self.materials
                         .iter()
@@ -1048,7 +1066,7 @@ impl Translator<'_> {
                 let Some(nodes) = nodes else {
                     self.cx.error_spanned_by(
                         &m.method,
-                        "`node` applies to deformable bodies built from beam elements (`Deformable { data: beam, .. }`)",
+                        format!("`{name}` applies to deformable bodies built from beam elements (`Deformable {{ data: beam, .. }}`)"),
                     );
                     return None;
                 };
@@ -1073,7 +1091,16 @@ impl Translator<'_> {
                     );
                     return None;
                 };
-                Value::Vector(nodes.at(self.g, dim, k))
+                if name == "node_rotation" {
+                    let r = nodes.rotation(self.g, dim, k);
+                    if dim == 2 {
+                        Value::Scalar(r[0])
+                    } else {
+                        Value::Vector(r)
+                    }
+                } else {
+                    Value::Vector(nodes.at(self.g, dim, k))
+                }
             }
             _ => unreachable!("frame methods are listed"),
         })
