@@ -14,6 +14,7 @@ mod partitioning;
 mod pendulum;
 mod projection;
 mod proportionality;
+mod published;
 mod redundant;
 mod robustness;
 mod rows;
