@@ -102,6 +102,7 @@ mod contacts;
 mod driver;
 mod error;
 mod formulation;
+mod guard;
 mod point;
 mod precision;
 mod stepper;
@@ -109,7 +110,7 @@ mod system;
 mod trajectory;
 
 pub use contacts::{ContactEvent, ContactEventKind};
-pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
+pub use error::{Monitored, NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
 pub use system::{Failed, StateSpace};
 pub use trajectory::{Monitors, Run, Stats, Trajectory};
