@@ -454,6 +454,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Guard::new(
                 info,
                 (!matches!(sim.method, Method::Rk4 { .. })).then_some((sim.rtol, sim.atol)),
+                !matches!(sim.formulation, Formulation::Baumgarte { .. }),
             )
         }),
     };
@@ -792,7 +793,11 @@ const RK4_STABILITY: f64 = 2.785;
 /// \sqrt{\alpha^2 - \beta^2}$ (modulus $\beta$ when complex), non-holonomic rows
 /// $\dot e = -2\alpha e$. The adaptive methods control their steps and are not
 /// checked.
-fn baumgarte_unstable(formulation: Formulation, method: Method, nonholonomic: bool) -> Option<SimErrorKind> {
+fn baumgarte_unstable(
+    formulation: Formulation,
+    method: Method,
+    nonholonomic: bool,
+) -> Option<SimErrorKind> {
     let (Formulation::Baumgarte { alpha, beta }, Method::Rk4 { h }) = (formulation, method) else {
         return None;
     };

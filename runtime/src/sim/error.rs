@@ -112,8 +112,9 @@ impl Monitored {
         match self {
             Self::PositionViolation { .. } => {
                 "1e4 times the tolerance at the size of the coordinates the constraint \
-                 involves, at most 5 % of that size: the integration has left the motion; \
-                 tighten the tolerance, shorten the step, or use partitioning or projection"
+                 involves, at most 5 % of that size (Baumgarte: 5 %; a fixed step: 50 %): \
+                 the integration has left the motion; tighten the tolerance, shorten the \
+                 step, or use partitioning or projection"
             }
             Self::Coordinates { .. } => {
                 "1e6 times the motion's scale at the start (the size of q0 plus the \
@@ -122,8 +123,9 @@ impl Monitored {
             }
             Self::EnergyDrift => {
                 "1e4 times the tolerance of the energy the motion exchanges (largest kinetic \
-                 energy, range of the potential), at most 5 % of it: the integration has \
-                 left the motion; tighten the tolerance or shorten the step"
+                 energy, range of the potential), at most 5 % of it (a fixed step: 50 %): \
+                 the integration has left the motion; tighten the tolerance or shorten the \
+                 step"
             }
         }
     }
