@@ -450,7 +450,7 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         overridden,
         repartition_times: Vec::new(),
         output_work: (0, 0),
-        guard: (sim.formulation != Formulation::Unconstrained).then(|| {
+        guard: (sim.monitors && sim.formulation != Formulation::Unconstrained).then(|| {
             Guard::new(
                 info,
                 (!matches!(sim.method, Method::Rk4 { .. })).then_some((sim.rtol, sim.atol)),

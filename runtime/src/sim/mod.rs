@@ -275,6 +275,7 @@ pub struct Simulation<'a, M: Mechanism + ?Sized> {
     kinematics: KinematicsParams,
     dynamics: DynamicsParams,
     progress: Option<Box<dyn FnMut(f64) + 'a>>,
+    monitors: bool,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for Simulation<'_, M> {
@@ -322,6 +323,7 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
                 ..DynamicsParams::default()
             },
             progress: None,
+            monitors: true,
         }
     }
 
@@ -433,6 +435,17 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
     #[must_use]
     pub fn dynamics(mut self, params: DynamicsParams) -> Self {
         self.dynamics = params;
+        self
+    }
+
+    /// Whether the run is stopped with [`SimErrorKind::Diverged`] when its constraint
+    /// violation, energy drift (conservative models) or coordinates grow beyond what
+    /// the tolerance and the motion's scale allow (on by default). Off, a diverging
+    /// run goes on until it fails otherwise or ends: for studying the divergence
+    /// itself, or the failure it leads to.
+    #[must_use]
+    pub fn monitors(mut self, on: bool) -> Self {
+        self.monitors = on;
         self
     }
 
