@@ -336,21 +336,7 @@ impl Kinematics {
                 self.partition = previous;
                 return Err(e.into());
             }
-            // Only the guesses Newton solves for need the move: the others (left
-            // independent by the new partition) go back to their values.
-            let dependent = &self
-                .partition
-                .as_ref()
-                .expect("partitioned above")
-                .dependent;
-            moved_guesses.retain(|m| {
-                let j = info.coordinate_index(m.coordinate).expect("a coordinate");
-                let solved = dependent.contains(&j);
-                if !solved {
-                    q[j] = m.guess;
-                }
-                solved
-            });
+            self.keep_solved_guesses(info, q, &mut moved_guesses);
         }
         let newton = if all_q {
             ws.eval_constraints(mech, t, q)?;
@@ -360,7 +346,31 @@ impl Kinematics {
                 step: 0.0,
             }
         } else {
-            self.position(mech, ws, t, q)?
+            match self.position(mech, ws, t, q) {
+                Ok(stats) => stats,
+                // A guess where C_q vanishes in the free coordinates that the constraint
+                // needs (a Cartesian pendulum with `x` held at 0 from `y` = 0: the rod's
+                // row is all zeros there, so Algorithm P sets it aside as dependent on
+                // the others and Newton never moves `y`): the same move of the singular
+                // guesses as when the partition fails, then once more.
+                Err(e @ KinematicsError::NewtonFailed { .. }) if moved_guesses.is_empty() => {
+                    q.copy_from_slice(&q0);
+                    let retried =
+                        move_singular_guesses(mech, ws, t, q, &pos_idx, &mut moved_guesses)?
+                            && self.repartition_with(mech, ws, t, q, prefs).is_ok();
+                    if retried {
+                        self.keep_solved_guesses(info, q, &mut moved_guesses);
+                    }
+                    match retried.then(|| self.position(mech, ws, t, q)) {
+                        Some(Ok(stats)) => stats,
+                        _ => {
+                            q.copy_from_slice(&q0);
+                            return Err(e.into());
+                        }
+                    }
+                }
+                Err(e) => return Err(e.into()),
+            }
         };
         if all_qd {
             check_velocities(mech, ws, t, q, qd)?;
@@ -380,6 +390,31 @@ impl Kinematics {
             velocity_residual,
             moved_guesses,
         })
+    }
+}
+
+impl Kinematics {
+    /// Only the moved guesses Newton solves for need the move: the others (left
+    /// independent by the current partition) go back to their values.
+    fn keep_solved_guesses(
+        &self,
+        info: &crate::Info,
+        q: &mut [f64],
+        moved_guesses: &mut Vec<MovedGuess>,
+    ) {
+        let dependent = &self
+            .partition
+            .as_ref()
+            .expect("partitioned above")
+            .dependent;
+        moved_guesses.retain(|m| {
+            let j = info.coordinate_index(m.coordinate).expect("a coordinate");
+            let solved = dependent.contains(&j);
+            if !solved {
+                q[j] = m.guess;
+            }
+            solved
+        });
     }
 }
 

@@ -20,6 +20,7 @@ use std::time::Instant;
 use super::contacts::{Found, Refined};
 use super::error::{SimError, SimErrorKind};
 use super::formulation::Correction;
+use super::guard::Guard;
 use super::stepper::Stepper;
 use super::system::System;
 use super::trajectory::{Monitors, Run, Stats, Trajectory};
@@ -90,6 +91,9 @@ struct Recorder<'a, 'm, M: Mechanism + ?Sized> {
     /// Newton iterations and factorizations spent on output rows (see
     /// [`output_row`](Self::output_row)).
     output_work: (u64, u64),
+    /// The divergence guard of the kept states (not for the unconstrained formulation,
+    /// which enforces nothing).
+    guard: Option<Guard>,
 }
 
 impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
@@ -101,6 +105,26 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
         self.monitors.observe(v, energy);
         if energy.is_some() {
             self.monitors.energy_final = energy;
+        }
+        if let Some(g) = self.guard.as_mut() {
+            let p = &mut self.sys.point;
+            let mut tripped = g.positions(t, &p.q, p.ws.constraints(), &p.ws.cq_values);
+            if let (None, Some(e0), true) =
+                (&tripped, self.monitors.energy_initial, p.info.conservative)
+            {
+                let parts = (
+                    p.mech.kinetic_energy(t, &p.q, &p.qd),
+                    p.mech.potential_energy(t, &p.q),
+                );
+                let lost = self.monitors.energy_lost_in_impacts;
+                tripped = g.energy(t, parts, e0, lost);
+            }
+            if let Some(kind) = tripped {
+                // The failure keeps this state as the partial run's last row: recorded
+                // without the guard.
+                self.guard = None;
+                return Err(kind);
+            }
         }
         Ok(v)
     }
@@ -250,6 +274,9 @@ impl<M: Mechanism + ?Sized> Recorder<'_, '_, M> {
             // first of NEAR_SINGULAR only: the failure itself says nothing of rank) is
             // the accelerations growing without bound at a lock.
             SimErrorKind::StepSizeTooSmall {
+                nearly_dependent, ..
+            }
+            | SimErrorKind::NoProgress {
                 nearly_dependent, ..
             } => *nearly_dependent = self.nearly_dependent(&NEAR_SINGULAR[..1]),
             _ => {}
@@ -424,9 +451,20 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         overridden,
         repartition_times: Vec::new(),
         output_work: (0, 0),
+        guard: (sim.monitors && sim.formulation != Formulation::Unconstrained).then(|| {
+            Guard::new(
+                info,
+                (!matches!(sim.method, Method::Rk4 { .. })).then_some((sim.rtol, sim.atol)),
+                !matches!(sim.formulation, Formulation::Baumgarte { .. }),
+            )
+        }),
     };
     if let Err(kind) = rec.record(t0) {
         return Err(rec.fail(None, kind));
+    }
+    if let Some(g) = rec.guard.as_mut() {
+        let p = &rec.sys.point;
+        g.set_motion(&p.q, &p.qd, p.qdd(), t_end - t0, sim.atol / sim.rtol);
     }
     if t_end == t0 {
         return Ok(rec.run(None));
@@ -458,6 +496,14 @@ pub(super) fn run<M: Mechanism + ?Sized>(
         max_steps: sim.max_steps,
         dense_output: interpolates,
     };
+    if let Some(kind) = baumgarte_unstable(sim.formulation, sim.method, info.nnh() > 0) {
+        return Err(rec.fail(None, kind));
+    }
+    // Baumgarte on a model whose constraints are independent at the start: a rank drop
+    // of the Jacobian along the run (the solve's redundant path naming rows) is a
+    // singular configuration it would integrate through.
+    let watch_rank = matches!(sim.formulation, Formulation::Baumgarte { .. })
+        && rec.sys.point.redundant.is_empty();
     let mut stepper = match Stepper::new(sim.method, dim, opts) {
         Ok(s) => s,
         Err(e) => return Err(rec.fail(None, SimErrorKind::Integrator(e))),
@@ -511,6 +557,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     let ode = SimErrorKind::from_ode;
 
+    // The window of the progress check: attempts and time at its start.
+    let mut window = (0_u64, t0);
     while stepper.t() < t_end {
         let attempts = stepper.stats().steps + stepper.stats().rejected;
         if attempts >= sim.max_steps {
@@ -518,6 +566,27 @@ pub(super) fn run<M: Mechanism + ?Sized>(
                 t: stepper.t(),
                 steps: sim.max_steps
             });
+        }
+        if attempts < window.0 {
+            window = (attempts, stepper.t());
+        }
+        if attempts >= window.0 + PROGRESS_WINDOW {
+            let t = stepper.t();
+            let advance = t - window.1;
+            let needed = (t_end - t) / advance * (attempts - window.0) as f64;
+            let budget = sim.max_steps - attempts;
+            #[allow(clippy::cast_precision_loss)]
+            if !(needed <= PROGRESS_MARGIN * budget as f64) {
+                bail!(SimErrorKind::NoProgress {
+                    t,
+                    window: attempts - window.0,
+                    advance,
+                    needed,
+                    budget,
+                    nearly_dependent: Vec::new(),
+                });
+            }
+            window = (attempts, t);
         }
         let t_prev = stepper.t();
         if refine_events {
@@ -674,6 +743,10 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             Correction::Changed => check!(stepper.set_state(rec.y).map_err(ode)),
         }
         check!(rec.sys.accept(t));
+        if watch_rank && !rec.sys.point.redundant.is_empty() {
+            let constraints = rec.sys.point.redundant.clone();
+            bail!(SimErrorKind::SingularConfiguration { t, constraints });
+        }
         if rec.sys.point.kin.repartitions() > partitions {
             rec.repartition_times.push(t);
         }
@@ -710,6 +783,56 @@ pub(super) fn run<M: Mechanism + ?Sized>(
     }
     Ok(rec.run(Some(&stepper)))
 }
+
+/// The largest $|h\lambda|$ on the negative real axis for which the classical RK4 is
+/// stable (the real root of $|1 + z + z^2/2 + z^3/6 + z^4/24| = 1$, $z \approx
+/// -2.785$).
+const RK4_STABILITY: f64 = 2.785;
+
+/// [`SimErrorKind::BaumgarteUnstable`] when Baumgarte stabilization runs with a fixed
+/// step that puts the constraint error's dynamics outside RK4's stability interval:
+/// $\ddot e + 2\alpha\dot e + \beta^2 e = 0$ has eigenvalues $-\alpha \pm
+/// \sqrt{\alpha^2 - \beta^2}$ (modulus $\beta$ when complex), non-holonomic rows
+/// $\dot e = -2\alpha e$. The adaptive methods control their steps and are not
+/// checked.
+fn baumgarte_unstable(
+    formulation: Formulation,
+    method: Method,
+    nonholonomic: bool,
+) -> Option<SimErrorKind> {
+    let (Formulation::Baumgarte { alpha, beta }, Method::Rk4 { h }) = (formulation, method) else {
+        return None;
+    };
+    let disc = alpha * alpha - beta * beta;
+    let holonomic = if disc >= 0.0 {
+        alpha.abs() + disc.sqrt()
+    } else {
+        beta.abs()
+    };
+    let rate = if nonholonomic {
+        holonomic.max(2.0 * alpha.abs())
+    } else {
+        holonomic
+    };
+    (h * rate > RK4_STABILITY).then_some(SimErrorKind::BaumgarteUnstable {
+        h,
+        alpha,
+        beta,
+        rate,
+        limit: RK4_STABILITY,
+    })
+}
+
+/// Step attempts between two checks of the run's progress
+/// ([`SimErrorKind::NoProgress`]).
+const PROGRESS_WINDOW: u64 = 10_000;
+
+/// How many times the attempts left the rest of the span may need, at the rate of the
+/// last window, before the run is stopped for making no progress: the rate would have
+/// to rise a hundredfold for the run to finish within its step limit, and a run
+/// creeping at step sizes of round-off is stopped after one window instead of
+/// spending the whole budget.
+const PROGRESS_MARGIN: f64 = 100.0;
 
 /// Most steps a run takes back ([`rank_drop_failure`]).
 const MAX_STEP_BACKS: u32 = 8;

@@ -83,6 +83,70 @@ impl fmt::Display for NonFiniteSource {
     }
 }
 
+/// What grew in a [`SimErrorKind::Diverged`] run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Monitored {
+    /// The distance of the positions from a holonomic constraint's surface,
+    /// $|C_i| / \lVert (C_q)_i\rVert_\infty$ in the units of $q$, against the size of
+    /// the coordinates it involves.
+    PositionViolation {
+        /// The constraint farthest from being met.
+        constraint: &'static str,
+    },
+    /// $|E - E_0|$ of a conservative model (the impacts' losses set apart), against its
+    /// energy scale (the largest kinetic energy and the range of the potential energy
+    /// seen so far).
+    EnergyDrift,
+    /// The size of the coordinates $\lVert q\rVert_\infty$ (the largest named),
+    /// against the motion's scale at the start: $\lVert q_0\rVert_\infty +
+    /// \lVert\dot q_0\rVert_\infty T + \lVert\ddot q_0\rVert_\infty T^2/2$ over the
+    /// span $T$.
+    Coordinates {
+        /// The largest coordinate.
+        coordinate: &'static str,
+    },
+}
+
+impl Monitored {
+    fn bound_reason(self) -> &'static str {
+        match self {
+            Self::PositionViolation { .. } => {
+                "1e4 times the tolerance at the size of the coordinates the constraint \
+                 involves, at most 5 % of that size (Baumgarte: 5 %; a fixed step: 50 %): \
+                 the integration has left the motion; tighten the tolerance, shorten the \
+                 step, or use partitioning or projection"
+            }
+            Self::Coordinates { .. } => {
+                "1e6 times the motion's scale at the start (the size of q0 plus the \
+                 distances its initial velocities and accelerations cover in the span): \
+                 the integration diverged; tighten the tolerance or shorten the step"
+            }
+            Self::EnergyDrift => {
+                "1e4 times the tolerance of the energy the motion exchanges (largest kinetic \
+                 energy, range of the potential), at most 5 % of it (a fixed step: 50 %): \
+                 the integration has left the motion; tighten the tolerance or shorten the \
+                 step"
+            }
+        }
+    }
+}
+
+impl fmt::Display for Monitored {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::PositionViolation { constraint } => write!(
+                f,
+                "the violation of constraint `{constraint}` (the distance of q from its \
+                 surface, |C_i| / |(C_q)_i|, in the units of q)"
+            ),
+            Self::EnergyDrift => f.write_str("the energy drift |E - E0|"),
+            Self::Coordinates { coordinate } => {
+                write!(f, "the size of the coordinates (|{coordinate}|)")
+            }
+        }
+    }
+}
+
 /// Why a simulation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimErrorKind {
@@ -211,6 +275,73 @@ pub enum SimErrorKind {
         /// The limit.
         steps: u64,
     },
+    /// A monitored quantity of an accepted state grew beyond what the run's tolerance
+    /// and the model's scale allow (see [`Monitored`]): the integration has left the
+    /// motion it was asked for, and its rows from there on would be a wrong answer.
+    #[error("{quantity} grew to {value:e} at t = {t:?}, beyond its bound {bound:e} ({})", quantity.bound_reason())]
+    Diverged {
+        /// Time of the accepted state.
+        t: f64,
+        /// What grew.
+        quantity: Monitored,
+        /// Its value there.
+        value: f64,
+        /// The largest value the tolerance and the model's scale allow.
+        bound: f64,
+    },
+    /// Baumgarte stabilization reached a configuration where the constraints are
+    /// dependent (their Jacobian lost rank) although they were independent at the
+    /// start: a singular configuration (a lock, a change point, a rolling disk lying
+    /// flat). Its equations keep a solution there (the minimum-norm split of the
+    /// dependent rows), so the run would go on through it onto any branch;
+    /// partitioning and projection stop there.
+    #[error("the constraints {constraints:?} became dependent at t = {t:?}: a singular configuration, which Baumgarte stabilization would integrate through onto an arbitrary branch")]
+    SingularConfiguration {
+        /// Time of the accepted state.
+        t: f64,
+        /// The constraints found dependent on the others.
+        constraints: Vec<&'static str>,
+    },
+    /// Baumgarte stabilization with a fixed step the method cannot integrate stably:
+    /// the constraint error obeys $\ddot e + 2\alpha\dot e + \beta^2 e = 0$ (and
+    /// $\dot e + 2\alpha e = 0$ for non-holonomic rows), whose fastest rate
+    /// `rate` times `h` lies outside the method's region of absolute stability.
+    #[error("Baumgarte stabilization (alpha = {alpha}, beta = {beta}) is unstable with the fixed step h = {h:e}: its constraint error decays at rate {rate:e} 1/s, and h * rate must stay below {limit} for the method; take h <= {:e} or smaller gains", limit / rate)]
+    BaumgarteUnstable {
+        /// The fixed step.
+        h: f64,
+        /// Velocity-level gain.
+        alpha: f64,
+        /// Position-level gain.
+        beta: f64,
+        /// The largest magnitude of the eigenvalues of the constraint error's dynamics.
+        rate: f64,
+        /// The stability limit of $h \cdot$ rate of the method on the negative real axis.
+        limit: f64,
+    },
+    /// The integration stopped making progress: at the rate of its last `window`
+    /// step attempts, which advanced the time by `advance`, the rest of the span would
+    /// need `needed` attempts, more than 100 times the `budget` of attempts left
+    /// ([`Simulation::max_steps`](super::Simulation::max_steps)). A run creeping at
+    /// step sizes far below its span (a singular configuration, a state the
+    /// formulation keeps failing at) ends here instead of running for hours into its
+    /// step limit.
+    #[error("no progress at t = {t:?}: the last {window} step attempts advanced the time by {advance:e}, at which rate the remaining span needs {needed:e} attempts, more than 100 times the {budget} left{}", lock_clause(nearly_dependent))]
+    NoProgress {
+        /// Time of the last accepted state.
+        t: f64,
+        /// The attempts of the window.
+        window: u64,
+        /// The time they advanced.
+        advance: f64,
+        /// The attempts the rest of the span needs at that rate.
+        needed: f64,
+        /// The attempts left before the step limit.
+        budget: u64,
+        /// The holonomic constraints nearly dependent at the last accepted state (see
+        /// [`Self::StepSizeTooSmall`]).
+        nearly_dependent: Vec<&'static str>,
+    },
     /// A NaN or an infinity.
     #[error("non-finite value at t = {t:?} in the {source_of}")]
     NonFinite {
@@ -243,6 +374,9 @@ impl SimErrorKind {
             | Self::SingularMass { t, .. }
             | Self::StepSizeTooSmall { t, .. }
             | Self::MaxSteps { t, .. }
+            | Self::Diverged { t, .. }
+            | Self::SingularConfiguration { t, .. }
+            | Self::NoProgress { t, .. }
             | Self::NonFinite { t, .. } => Some(*t),
             Self::Impact(
                 crate::ImpactError::Singular { t, .. } | crate::ImpactError::SingularMass { t, .. },

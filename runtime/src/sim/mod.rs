@@ -101,6 +101,7 @@ mod contacts;
 mod driver;
 mod error;
 mod formulation;
+mod guard;
 mod point;
 mod precision;
 mod stepper;
@@ -108,7 +109,7 @@ mod system;
 mod trajectory;
 
 pub use contacts::{ContactEvent, ContactEventKind};
-pub use error::{NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
+pub use error::{Monitored, NonFiniteSource, SimError, SimErrorKind, SingularMatrix};
 pub use precision::{format_table, work_precision, Reference, Row, Sweep};
 pub use system::{Failed, StateSpace};
 pub use trajectory::{Monitors, Run, Stats, Trajectory};
@@ -273,6 +274,7 @@ pub struct Simulation<'a, M: Mechanism + ?Sized> {
     kinematics: KinematicsParams,
     dynamics: DynamicsParams,
     progress: Option<Box<dyn FnMut(f64) + 'a>>,
+    monitors: bool,
 }
 
 impl<M: Mechanism + ?Sized> std::fmt::Debug for Simulation<'_, M> {
@@ -320,6 +322,7 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
                 ..DynamicsParams::default()
             },
             progress: None,
+            monitors: true,
         }
     }
 
@@ -431,6 +434,17 @@ impl<'a, M: Mechanism + ?Sized> Simulation<'a, M> {
     #[must_use]
     pub fn dynamics(mut self, params: DynamicsParams) -> Self {
         self.dynamics = params;
+        self
+    }
+
+    /// Whether the run is stopped with [`SimErrorKind::Diverged`] when its constraint
+    /// violation, energy drift (conservative models) or coordinates grow beyond what
+    /// the tolerance and the motion's scale allow (on by default). Off, a diverging
+    /// run goes on until it fails otherwise or ends: for studying the divergence
+    /// itself, or the failure it leads to.
+    #[must_use]
+    pub fn monitors(mut self, on: bool) -> Self {
+        self.monitors = on;
         self
     }
 

@@ -9,6 +9,7 @@ mod andrews;
 mod declared;
 mod exact;
 mod faults;
+mod guards;
 mod models;
 mod partitioning;
 mod pendulum;
