@@ -7,7 +7,7 @@ use quote::ToTokens;
 use crate::sym::{ExprId, Graph, Node};
 use crate::{ctxt, derive, model, parse};
 
-#[path = "../../../models/src/chain/source.rs"]
+#[path = "chain_unrolled.rs"]
 mod chain;
 
 /// The `#[mechanism]` modules of a source file, the attribute removed (its arguments,
