@@ -26,7 +26,9 @@ pub mod chain10 {
 
     const _: () = for i in 0..N {
         /// Rod centre, x [m].
-        static x: Coordinate = Coordinate { q0: (i as f64 + 0.5) * l };
+        static x: Coordinate = Coordinate {
+            q0: (i as f64 + 0.5) * l,
+        };
         /// Rod centre, y [m].
         static y: Coordinate = Coordinate {};
         /// Rod centre, z [m].
@@ -56,7 +58,11 @@ pub mod chain10 {
         a: link[i],
         at_a: [-0.5 * l, 0.0, 0.0],
         b: if i == 0 { ground } else { link[i - 1] },
-        at_b: if i == 0 { [0.0, 0.0, 0.0] } else { [0.5 * l, 0.0, 0.0] },
+        at_b: if i == 0 {
+            [0.0, 0.0, 0.0]
+        } else {
+            [0.5 * l, 0.0, 0.0]
+        },
     });
 
     /// Height of the free end [m].
@@ -84,7 +90,9 @@ pub mod chain100 {
 
     const _: () = for i in 0..N {
         /// Rod centre, x [m].
-        static x: Coordinate = Coordinate { q0: (i as f64 + 0.5) * l };
+        static x: Coordinate = Coordinate {
+            q0: (i as f64 + 0.5) * l,
+        };
         /// Rod centre, y [m].
         static y: Coordinate = Coordinate {};
         /// Rod centre, z [m].
@@ -114,7 +122,11 @@ pub mod chain100 {
         a: link[i],
         at_a: [-0.5 * l, 0.0, 0.0],
         b: if i == 0 { ground } else { link[i - 1] },
-        at_b: if i == 0 { [0.0, 0.0, 0.0] } else { [0.5 * l, 0.0, 0.0] },
+        at_b: if i == 0 {
+            [0.0, 0.0, 0.0]
+        } else {
+            [0.5 * l, 0.0, 0.0]
+        },
     });
 
     /// Height of the free end [m].

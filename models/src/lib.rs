@@ -124,9 +124,9 @@ pub use sleigh_model::sleigh;
 pub use sleigh_wall_model::sleigh_wall;
 pub use slider_crank_bodies_model::slider_crank_bodies;
 pub use slider_crank_model::slider_crank;
-pub use window_row_model::window_row;
 pub use spatial_four_bar_model::spatial_four_bar;
 pub use spinup_beam_model::spinup_beam;
+pub use window_row_model::window_row;
 
 /// A built-in model as listed by the command-line program.
 #[derive(Clone, Copy, Debug)]

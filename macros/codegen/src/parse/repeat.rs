@@ -315,10 +315,8 @@ impl Expander<'_> {
         let a = self.eval_required(start, env, "a range's start")?;
         let b = self.eval_required(end, env, "a range's end")?;
         if a < 0 {
-            self.cx.error_spanned_by(
-                start,
-                format!("negative index {a}: indices start at 0"),
-            );
+            self.cx
+                .error_spanned_by(start, format!("negative index {a}: indices start at 0"));
             return None;
         }
         let b = match r.limits {
@@ -363,10 +361,7 @@ impl Expander<'_> {
             values.push(v);
         }
         if !array.indices.contains(&values) {
-            let shown = values
-                .iter()
-                .map(|v| format!("[{v}]"))
-                .collect::<String>();
+            let shown = values.iter().map(|v| format!("[{v}]")).collect::<String>();
             self.cx.error_spanned_by(
                 whole,
                 format!(
@@ -683,7 +678,8 @@ impl Expander<'_> {
                         let mut idx = suffix.to_vec();
                         idx.push(k as i64);
                         let mut el = s.clone();
-                        el.ident = syn::Ident::new(&element_name(&unraw(&s.ident), &idx), s.ident.span());
+                        el.ident =
+                            syn::Ident::new(&element_name(&unraw(&s.ident), &idx), s.ident.span());
                         el.ty = Box::new(elem.clone());
                         el.expr = Box::new(init);
                         out.push(syn::Item::Static(el));
@@ -727,7 +723,10 @@ impl Expander<'_> {
                 if a.elems.len() as i64 != n {
                     self.cx.error_spanned_by(
                         init,
-                        format!("the initializer has {} elements, the array {n}", a.elems.len()),
+                        format!(
+                            "the initializer has {} elements, the array {n}",
+                            a.elems.len()
+                        ),
                     );
                     return None;
                 }
@@ -739,15 +738,21 @@ impl Expander<'_> {
                     && c.args.len() == 1 =>
             {
                 let syn::Expr::Closure(cl) = &c.args[0] else {
-                    self.cx.error_spanned_by(&c.args[0], "expected a closure `|i| ..`");
+                    self.cx
+                        .error_spanned_by(&c.args[0], "expected a closure `|i| ..`");
                     return None;
                 };
                 let [syn::Pat::Ident(var)] = cl.inputs.iter().collect::<Vec<_>>().as_slice() else {
-                    self.cx.error_spanned_by(&cl.inputs, "the closure takes one index: `|i| ..`");
+                    self.cx
+                        .error_spanned_by(&cl.inputs, "the closure takes one index: `|i| ..`");
                     return None;
                 };
                 let var = unraw(&var.ident);
-                Some((0..n).map(|k| ((*cl.body).clone(), env.with(&var, k))).collect())
+                Some(
+                    (0..n)
+                        .map(|k| ((*cl.body).clone(), env.with(&var, k)))
+                        .collect(),
+                )
             }
             other => {
                 self.cx.error_spanned_by(
@@ -811,7 +816,8 @@ impl Expander<'_> {
         for item in items {
             match item {
                 syn::Item::Const(c) if is_usize(&c.ty) => {
-                    if let Some(v) = self.eval_required(&c.expr, &Env::default(), "a `usize` constant")
+                    if let Some(v) =
+                        self.eval_required(&c.expr, &Env::default(), "a `usize` constant")
                     {
                         if v < 0 {
                             self.cx.error_spanned_by(
@@ -829,7 +835,14 @@ impl Expander<'_> {
                     for (name, indices) in names {
                         let rank = indices.iter().next().map_or(1, Vec::len);
                         let shape = shape_of(&indices);
-                        self.arrays.insert(name, Array { rank, indices, shape });
+                        self.arrays.insert(
+                            name,
+                            Array {
+                                rank,
+                                indices,
+                                shape,
+                            },
+                        );
                     }
                 }
                 syn::Item::Static(s) => {
@@ -839,7 +852,11 @@ impl Expander<'_> {
                             let indices = (0..n.max(0)).map(|k| vec![k]).collect();
                             self.arrays.insert(
                                 name,
-                                Array { rank: 1, indices, shape: format!("0..{n}") },
+                                Array {
+                                    rank: 1,
+                                    indices,
+                                    shape: format!("0..{n}"),
+                                },
                             );
                         }
                         if let Some(v) = closure_var(&s.expr) {
@@ -883,7 +900,10 @@ impl Expander<'_> {
                     if let Eval::Value(n) = probe.eval(len, env) {
                         for k in 0..n.max(0) {
                             idx.push(k);
-                            names.entry(unraw(&st.ident)).or_default().insert(idx.clone());
+                            names
+                                .entry(unraw(&st.ident))
+                                .or_default()
+                                .insert(idx.clone());
                             idx.pop();
                         }
                     }
@@ -892,7 +912,10 @@ impl Expander<'_> {
                 }
             }
             syn::Stmt::Item(syn::Item::Fn(f)) => {
-                names.entry(unraw(&f.sig.ident)).or_default().insert(idx.to_vec());
+                names
+                    .entry(unraw(&f.sig.ident))
+                    .or_default()
+                    .insert(idx.to_vec());
             }
             syn::Stmt::Expr(inner @ syn::Expr::ForLoop(_), _) => {
                 this.collect_loops(inner, env, idx, names);
@@ -928,7 +951,9 @@ impl Expander<'_> {
 }
 
 fn closure_var(init: &syn::Expr) -> Option<String> {
-    let syn::Expr::Call(c) = init else { return None };
+    let syn::Expr::Call(c) = init else {
+        return None;
+    };
     let syn::Expr::Closure(cl) = c.args.first()? else {
         return None;
     };
