@@ -4,8 +4,7 @@
 use proc_macro2::TokenStream;
 use quote::ToTokens;
 
-#[path = "chain_unrolled.rs"]
-mod chain;
+use crate::sparsity::chain;
 
 /// The `#[mechanism]` module `name` of a source file, its attribute and docs removed.
 fn module(src: &str, name: &str) -> TokenStream {

@@ -8,7 +8,7 @@ use crate::sym::{ExprId, Graph, Node};
 use crate::{ctxt, derive, model, parse};
 
 #[path = "chain_unrolled.rs"]
-mod chain;
+pub(crate) mod chain;
 
 /// The `#[mechanism]` modules of a source file, the attribute removed (its arguments,
 /// e.g. `linearize`, kept with the module).

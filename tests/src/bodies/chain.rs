@@ -126,7 +126,11 @@ fn a_row_of_windows_swings_as_a_compound_pendulum() {
              phi' = {:.1e}, |C| {:.1e}",
             q[pc0], qd[pc0], run.monitors.max_position_violation
         );
-        assert!((q[pc0] - target).abs() < 1e-7, "{formulation:?}: {}", q[pc0]);
+        assert!(
+            (q[pc0] - target).abs() < 1e-7,
+            "{formulation:?}: {}",
+            q[pc0]
+        );
         assert!((q[pc4] - q[pc0]).abs() < 1e-9, "the cranks stay parallel");
         assert!(qd[pc0].abs() < 1e-5, "a turning point: {}", qd[pc0]);
         assert!(run.monitors.max_position_violation < 1e-10);

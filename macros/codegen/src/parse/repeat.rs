@@ -988,26 +988,24 @@ fn sum_vars(items: &[syn::Item], vars: &mut HashSet<String>) {
         // `map ( | i |`: the closure's first parameter.
         let tts: Vec<proc_macro2::TokenTree> = ts.into_iter().collect();
         for (k, tt) in tts.iter().enumerate() {
-            match tt {
-                proc_macro2::TokenTree::Group(g) => {
-                    if k > 0 {
-                        if let proc_macro2::TokenTree::Ident(m) = &tts[k - 1] {
-                            if m == "map" || m == "from_fn" {
-                                let inner: Vec<_> = g.stream().into_iter().collect();
-                                if let [proc_macro2::TokenTree::Punct(p), proc_macro2::TokenTree::Ident(v), ..] =
-                                    inner.as_slice()
-                                {
-                                    if p.as_char() == '|' {
-                                        vars.insert(v.to_string());
-                                    }
-                                }
+            let proc_macro2::TokenTree::Group(g) = tt else {
+                continue;
+            };
+            if k > 0 {
+                if let proc_macro2::TokenTree::Ident(m) = &tts[k - 1] {
+                    if m == "map" || m == "from_fn" {
+                        let inner: Vec<_> = g.stream().into_iter().collect();
+                        if let [proc_macro2::TokenTree::Punct(p), proc_macro2::TokenTree::Ident(v), ..] =
+                            inner.as_slice()
+                        {
+                            if p.as_char() == '|' {
+                                vars.insert(v.to_string());
                             }
                         }
                     }
-                    walk(g.stream(), vars);
                 }
-                _ => {}
             }
+            walk(g.stream(), vars);
         }
     }
     for item in items {
