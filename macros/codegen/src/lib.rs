@@ -26,6 +26,8 @@ pub mod measure;
 pub mod model;
 pub mod parse;
 #[cfg(test)]
+mod repeat_tests;
+#[cfg(test)]
 mod robustness;
 pub mod sched;
 #[cfg(test)]

@@ -7,8 +7,8 @@ use quote::ToTokens;
 use crate::sym::{ExprId, Graph, Node};
 use crate::{ctxt, derive, model, parse};
 
-#[path = "../../../models/src/chain/source.rs"]
-mod chain;
+#[path = "chain_unrolled.rs"]
+pub(crate) mod chain;
 
 /// The `#[mechanism]` modules of a source file, the attribute removed (its arguments,
 /// e.g. `linearize`, kept with the module).

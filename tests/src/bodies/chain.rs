@@ -80,3 +80,59 @@ fn hundred_links_fall_alike_in_both_formulations() {
     assert!(moved > 1e-2, "the chain fell: moved by {moved:e}");
     assert!(d < 1e-9, "chain100: the formulations differ by {d:e}");
 }
+
+/// `window_row` (written with arrays: 4 parallelogram windows, 5 cranks and 4 couplers
+/// on 13 revolute joints) is a compound pendulum: the couplers translate with speed
+/// `l φ̇`, the cranks turn about their pivots, so `T = ½ J φ̇²` with
+/// `J = (N+1) ρ l l²/3 + N ρ d l²` and `V = k sin φ` with
+/// `k = g ((N+1) ρ l l/2 + N ρ d l)`. Released at rest at `φ = −π/3`, 30° off the
+/// hanging equilibrium, it swings to the other turning point `−2π/3` in half the
+/// period of the pendulum of amplitude `θ₀ = π/6`: `T/2 = 2 K(sin(θ₀/2)) / ω₀`,
+/// `ω₀² = k/J` (closed form; `K` by the arithmetic-geometric mean).
+#[test]
+fn a_row_of_windows_swings_as_a_compound_pendulum() {
+    use pfaff::Mechanism;
+    let model = pfaff_models::window_row::Model::default();
+    let info = model.info();
+    let names: Vec<&str> = info.coordinates.iter().map(|c| c.name).collect();
+    assert_eq!(names.len(), 27, "9 bars, 3 coordinates each: {names:?}");
+    assert_eq!(info.holonomic.len(), 26, "13 revolute joints");
+    let pc0 = names.iter().position(|n| *n == "pc_0").expect("pc_0");
+    let pc4 = names.iter().position(|n| *n == "pc_4").expect("pc_4");
+    // Parameters of models/src/window_row.rs.
+    let (n, l, d, rho, g): (f64, f64, f64, f64, f64) = (4.0, 0.5, 0.3, 2.0, 9.81);
+    let j = (n + 1.0) * rho * l * l * l / 3.0 + n * rho * d * l * l;
+    let k = g * ((n + 1.0) * rho * l * l / 2.0 + n * rho * d * l);
+    let w0 = (k / j).sqrt();
+    let theta0 = std::f64::consts::PI / 6.0;
+    let (mut a, mut b) = (1.0_f64, (1.0 - (theta0 / 2.0).sin().powi(2)).sqrt());
+    for _ in 0..30 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    let kk = std::f64::consts::PI / (2.0 * a);
+    let half = 2.0 * kk / w0;
+    for formulation in [Formulation::Projection, Formulation::Partitioning] {
+        let run = Simulation::new(&model)
+            .formulation(formulation)
+            .integrator(Method::Dop853)
+            .tolerances(1e-10, 1e-12)
+            .output_times(&[])
+            .run(half)
+            .unwrap_or_else(|e| panic!("{formulation:?}: {e}"));
+        let (_, q, qd) = run.final_state().expect("a final row");
+        let target = -2.0 * std::f64::consts::PI / 3.0;
+        eprintln!(
+            "window_row {formulation:?}: phi(T/2) = {:.12} (closed form {target:.12}), \
+             phi' = {:.1e}, |C| {:.1e}",
+            q[pc0], qd[pc0], run.monitors.max_position_violation
+        );
+        assert!(
+            (q[pc0] - target).abs() < 1e-7,
+            "{formulation:?}: {}",
+            q[pc0]
+        );
+        assert!((q[pc4] - q[pc0]).abs() < 1e-9, "the cranks stay parallel");
+        assert!(qd[pc0].abs() < 1e-5, "a turning point: {}", qd[pc0]);
+        assert!(run.monitors.max_position_violation < 1e-10);
+    }
+}

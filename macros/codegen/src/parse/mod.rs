@@ -5,6 +5,7 @@
 //! checks only the *shape* of each item; names are resolved in `model`.
 
 pub mod kw;
+pub mod repeat;
 
 use proc_macro2::TokenStream;
 use quote::ToTokens;
@@ -140,7 +141,7 @@ pub fn parse(cx: &Ctxt, args: TokenStream, input: TokenStream) -> Option<Mechani
         return None;
     };
     let (docs, attrs) = split_docs(module.attrs);
-    let items = content
+    let items = repeat::expand(cx, content)
         .into_iter()
         .filter_map(|item| parse_item(cx, item))
         .collect();
@@ -187,7 +188,10 @@ fn parse_item(cx: &Ctxt, item: syn::Item) -> Option<Item> {
             let (docs, attrs) = split_docs(c.attrs);
             reject_attrs(cx, &attrs);
             if !is_type(&c.ty, "f64") {
-                cx.error_spanned_by(&c.ty, "parameters have type `f64`");
+                cx.error_spanned_by(
+                    &c.ty,
+                    "parameters have type `f64` (`usize` constants give lengths and indices)",
+                );
             }
             Some(Item::Param {
                 name: c.ident,
