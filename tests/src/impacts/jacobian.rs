@@ -102,18 +102,11 @@ fn body_level_gaps_are_signed_distances() {
 fn contact_jacobians_match_finite_differences() {
     let mut rng = Rng::new(11);
     let mut checked = 0;
-    let extra = pfaff_models::Entry {
-        name: "moving_floor",
-        summary: "",
-        make: || Box::new(moving_floor::Model::default()),
-        stiff: false,
-    };
-    let surfaces = pfaff_models::Entry {
-        name: "surfaces",
-        summary: "",
-        make: || Box::new(surfaces::Model::default()),
-        stiff: false,
-    };
+    let extra = pfaff_models::Entry::new("moving_floor", "", || {
+        Box::new(moving_floor::Model::default())
+    });
+    let surfaces =
+        pfaff_models::Entry::new("surfaces", "", || Box::new(surfaces::Model::default()));
     for entry in pfaff_models::all().iter().chain([&extra, &surfaces]) {
         let model = (entry.make)();
         let info = model.info();
