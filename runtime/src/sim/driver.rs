@@ -575,7 +575,8 @@ pub(super) fn run<M: Mechanism + ?Sized>(
             let advance = t - window.1;
             let needed = (t_end - t) / advance * (attempts - window.0) as f64;
             let budget = sim.max_steps - attempts;
-            #[allow(clippy::cast_precision_loss)]
+            // Negated so that a NaN rate (no advance at all) stops the run too.
+            #[allow(clippy::cast_precision_loss, clippy::neg_cmp_op_on_partial_ord)]
             if !(needed <= PROGRESS_MARGIN * budget as f64) {
                 bail!(SimErrorKind::NoProgress {
                     t,

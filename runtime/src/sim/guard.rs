@@ -159,7 +159,7 @@ impl Guard {
                 (None, _) => FIXED_CAP * s,
             }
             .max(floor);
-            if distance > allowed && worst.map_or(true, |(_, d, a)| distance / allowed > d / a) {
+            if distance > allowed && worst.is_none_or(|(_, d, a)| distance / allowed > d / a) {
                 worst = Some((i, distance, allowed));
             }
         }

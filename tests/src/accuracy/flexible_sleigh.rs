@@ -43,6 +43,7 @@ fn nodal(basis: &[f64], p: &[f64]) -> Vec<f64> {
 }
 
 /// 5-point Gauss–Legendre on [0, 1] (exact to degree 9; the integrands have degree ≤ 6).
+#[allow(clippy::excessive_precision)] // the digits of the tabulated nodes and weights
 const GAUSS: [(f64, f64); 5] = [
     (0.046_910_077_030_668_0, 0.118_463_442_528_094_5),
     (0.230_765_344_947_158_5, 0.239_314_335_249_683_2),
