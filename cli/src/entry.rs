@@ -65,7 +65,7 @@ impl Entry {
         self
     }
 
-    /// The default end time of `simulate` [s], and why that span.
+    /// The default end time of `simulate` \[s\], and why that span.
     #[must_use]
     pub const fn span(mut self, t_end: f64, why: &'static str) -> Self {
         self.scene.t_end = t_end;

@@ -115,22 +115,31 @@ fn printed_formulas_are_linear_in_the_shared_graph() {
 /// `cargo bench -p pfaff-tests --bench codegen`, group `long_sum`).
 #[test]
 fn a_long_sum_expands() {
-    let mut e = quote!(x);
-    for i in 2..=6000 {
-        let c = proc_macro2::Literal::i32_unsuffixed(i);
-        e = quote!(#e + #c * x.powi(#c));
-    }
-    let out = expand(quote!(
-        mod m {
-            static x: Coordinate = Coordinate {};
-            fn kinetic_energy() -> f64 {
-                0.5 * x.dot().powi(2)
+    // The 6,000-deep left-nested sum is parsed and dropped recursively: on a thread
+    // with a stack like the compiler's own (8 MiB and more), not a test thread's 2 MiB.
+    let out = std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(|| {
+            let mut e = quote!(x);
+            for i in 2..=6000 {
+                let c = proc_macro2::Literal::i32_unsuffixed(i);
+                e = quote!(#e + #c * x.powi(#c));
             }
-            fn potential_energy() -> f64 {
-                #e
-            }
-        }
-    ));
+            expand(quote!(
+                mod m {
+                    static x: Coordinate = Coordinate {};
+                    fn kinetic_energy() -> f64 {
+                        0.5 * x.dot().powi(2)
+                    }
+                    fn potential_energy() -> f64 {
+                        #e
+                    }
+                }
+            ))
+        })
+        .expect("thread spawns")
+        .join()
+        .expect("expansion does not panic");
     assert!(
         !out.contains("compile_error"),
         "{}",
