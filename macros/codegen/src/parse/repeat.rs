@@ -635,8 +635,13 @@ impl Expander<'_> {
 
     /// Expands one item declared with the index `suffix` (empty at the top level).
     fn item(&self, item: syn::Item, env: &Env, suffix: &[i64], out: &mut Vec<syn::Item>) {
+        // Outside a loop the name is kept as written (a raw `r#type` stays raw).
         let rename = |id: &syn::Ident| -> syn::Ident {
-            syn::Ident::new(&element_name(&unraw(id), suffix), id.span())
+            if suffix.is_empty() {
+                id.clone()
+            } else {
+                syn::Ident::new(&element_name(&unraw(id), suffix), id.span())
+            }
         };
         match item {
             syn::Item::Const(c) if is_usize(&c.ty) => {
